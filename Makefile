@@ -1,0 +1,40 @@
+# Every target sets up what it needs when missing (idempotent): a local .venv with the
+# package and its test extra, and a Vulkan driver for GGUI (Debian's mesa-vulkan-drivers).
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.crowndemo-installed
+
+.PHONY: setup vulkan demo test bench clean
+
+setup: $(STAMP) vulkan
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+	$(PY) -m pip install --quiet -e '.[test]'
+	touch $(STAMP)
+
+# GGUI needs a Vulkan driver; on a machine without a GPU, Mesa's lavapipe provides one.
+vulkan:
+	@if ls /usr/share/vulkan/icd.d/*.json >/dev/null 2>&1 || ls /etc/vulkan/icd.d/*.json >/dev/null 2>&1; then \
+	  true; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "installing mesa-vulkan-drivers (software Vulkan for offscreen rendering)"; \
+	  (apt-get install -y -qq mesa-vulkan-drivers >/dev/null 2>&1 || \
+	   (apt-get update -qq && apt-get install -y -qq mesa-vulkan-drivers >/dev/null)); \
+	else \
+	  echo "warning: no Vulkan driver found; install mesa-vulkan-drivers (Debian) for offscreen rendering"; \
+	fi
+
+demo: setup
+	$(VENV)/bin/crowndemo scene dam-break --dim 3 --t-end 0.05
+
+test: setup
+	$(PY) -m pytest -q
+
+bench: setup
+	$(VENV)/bin/crowndemo bench
+
+clean:
+	rm -rf $(VENV) .pytest_cache

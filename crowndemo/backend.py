@@ -1,0 +1,78 @@
+"""The one place that calls ``ti.init``: arch, float precision, random seed, threads."""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Optional
+
+import taichi as ti
+
+ARCHS = ("cpu", "cuda", "vulkan", "gpu", "auto")
+PRECISIONS = ("f32", "f64")
+
+
+@dataclass(frozen=True)
+class Backend:
+    arch: str          # what was asked for
+    resolved: str      # what Taichi started on (x64, arm64, cuda, vulkan, ...)
+    precision: str
+    seed: int
+    single_thread: bool
+
+
+_current: Optional[Backend] = None
+
+
+class BackendError(ValueError):
+    """A bad arch/precision choice, reported before any kernel runs."""
+
+
+def _arch_object(name: str):
+    return {"cpu": ti.cpu, "cuda": ti.cuda, "vulkan": ti.vulkan, "gpu": ti.gpu}[name]
+
+
+def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
+         single_thread: bool = False, quiet: bool = True) -> Backend:
+    """Start Taichi once per process.
+
+    ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` tries a GPU
+    and falls back to the CPU. ``single_thread`` makes CPU runs bit-reproducible. A second
+    call with the same settings is a no-op; with other settings Taichi is reset.
+    """
+    global _current
+    arch = (arch or os.environ.get("CROWNDEMO_ARCH") or "cpu").lower()
+    if arch not in ARCHS:
+        raise BackendError(f"arch {arch!r} is not one of {', '.join(ARCHS)} "
+                           "(--arch or CROWNDEMO_ARCH)")
+    if precision not in PRECISIONS:
+        raise BackendError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}")
+    wanted = (arch, precision, int(seed), bool(single_thread))
+    if _current is not None and (_current.arch, _current.precision, _current.seed,
+                                 _current.single_thread) == wanted:
+        return _current
+    if _current is not None:
+        ti.reset()
+    kwargs = dict(default_fp=ti.f64 if precision == "f64" else ti.f32,
+                  default_ip=ti.i32, random_seed=int(seed), offline_cache=True,
+                  log_level=ti.WARN if quiet else ti.INFO)
+    if single_thread:
+        kwargs["cpu_max_num_threads"] = 1
+    if arch == "auto":
+        ti.init(arch=ti.gpu, **kwargs)  # Taichi falls back to the CPU when no GPU works
+    else:
+        ti.init(arch=_arch_object(arch), **kwargs)
+        if arch in ("cuda", "vulkan", "gpu") and ti.lang.impl.current_cfg().arch in (ti.x64, ti.arm64):
+            raise BackendError(f"arch {arch!r} was asked for but Taichi found no such device "
+                               "(it fell back to the CPU); use --arch cpu")
+    resolved = str(ti.lang.impl.current_cfg().arch).split(".")[-1]
+    _current = Backend(arch, resolved, precision, int(seed), bool(single_thread))
+    return _current
+
+
+def current() -> Backend:
+    """The running backend; starts the default (CPU, f32) one if none is running."""
+    return _current if _current is not None else init()
+
+
+def is_f64() -> bool:
+    return current().precision == "f64"

@@ -1,0 +1,39 @@
+"""Run-time constants of the step, held in 0-D fields so that changing them never recompiles."""
+
+import taichi as ti
+
+from .lattice import LatticeConstants
+from .params import Numerics, Physics
+
+
+@ti.data_oriented
+class Coefficients:
+    def __init__(self, dim: int):
+        self.dim = dim
+        s = lambda: ti.field(float, shape=())
+        self.l0, self.re, self.re2, self.n0, self.lambda0 = s(), s(), s(), s(), s()
+        self.rho, self.nu, self.c2, self.mass = s(), s(), s(), s()
+        self.st_over_m = s()          # C / m of the potential model (S24)
+        self.beta = s()               # free-surface threshold (M3)
+        self.gravity = ti.Vector.field(dim, float, shape=())
+        self.domain_lo = ti.Vector.field(dim, float, shape=())
+        self.domain_hi = ti.Vector.field(dim, float, shape=())
+
+    def set(self, physics: Physics, numerics: Numerics, lattice: LatticeConstants,
+            domain_lo, domain_hi) -> None:
+        self.l0[None] = physics.l0
+        self.re[None] = lattice.re
+        self.re2[None] = lattice.re ** 2
+        self.n0[None] = lattice.n0
+        self.lambda0[None] = lattice.lambda0
+        self.rho[None] = physics.rho
+        self.nu[None] = physics.nu
+        self.c2[None] = physics.c ** 2
+        self.mass[None] = lattice.mass
+        self.st_over_m[None] = lattice.C / lattice.mass
+        self.beta[None] = numerics.free_surface_beta(physics.dim)
+        g = [0.0] * self.dim
+        g[-1] = -physics.gravity
+        self.gravity[None] = g
+        self.domain_lo[None] = list(domain_lo)
+        self.domain_hi[None] = list(domain_hi)

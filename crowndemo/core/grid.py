@@ -1,0 +1,173 @@
+"""Dynamic cell grid: bounds follow the live particles, counting sort, 3^d neighbour walk.
+
+The grid is rebuilt from scratch whenever positions change: bounds by reduction, cell count per
+cell, a blocked two-level prefix sum that runs on the CPU and GPU archs alike (Taichi's
+PrefixSumExecutor does not run on the CPU), then a scatter into ``order`` (particle indices in
+cell order). Cells have side >= re, so every neighbour within re lies in the 3^d cells around.
+If the live particles spread so far that the cells would not fit in ``max_cells``, the cell side
+grows: the walk stays exact, only more candidate pairs are visited.
+"""
+
+import taichi as ti
+
+from .state import GONE, ParticleState
+
+SCAN_BLOCK = 1024
+
+
+@ti.data_oriented
+class CellGrid:
+    def __init__(self, state: ParticleState, max_cells: int):
+        d = self.dim = state.dim
+        self.state = state
+        self.max_cells = int(max_cells)
+        self.lo = ti.field(float, d)
+        self.hi = ti.field(float, d)
+        self.origin = ti.field(float, d)
+        self.dims = ti.field(ti.i32, d)
+        self.side = ti.field(float, shape=())
+        self.num_cells = ti.field(ti.i32, shape=())
+        self.n_live = ti.field(ti.i32, shape=())
+        self.n_parked = ti.field(ti.i32, shape=())
+        self.cell_count = ti.field(ti.i32, self.max_cells)
+        self.cell_start = ti.field(ti.i32, self.max_cells + 1)
+        self.block_sum = ti.field(ti.i32, (self.max_cells + SCAN_BLOCK - 1) // SCAN_BLOCK)
+        self.particle_cell = ti.field(ti.i32, state.capacity)
+        self.rank = ti.field(ti.i32, state.capacity)
+        self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
+
+    def nbytes(self) -> int:
+        from .state import field_nbytes
+        return sum(field_nbytes(f) for f in (self.cell_count, self.cell_start, self.block_sum,
+                                             self.particle_cell, self.rank, self.order))
+
+    def build(self, min_side: float, reorder: bool = False) -> None:
+        """Rebuild at the current positions; with ``reorder`` permute the particles into cell
+        order (every persistent field, through the state's registry)."""
+        self._plan(min_side)
+        self._sort()
+        if reorder:
+            self.state.permute(self.order)
+            self._identity_order()
+
+    # ---- kernels -------------------------------------------------------------------------
+    @ti.kernel
+    def _plan(self, min_side: float):
+        d = ti.static(self.dim)
+        pos, kind = ti.static(self.state.pos, self.state.kind)
+        for k in ti.static(range(d)):
+            self.lo[k] = 3.0e38
+            self.hi[k] = -3.0e38
+        for i in range(self.state.n[None]):
+            if kind[i] != GONE:
+                for k in ti.static(range(d)):
+                    ti.atomic_min(self.lo[k], pos[i][k])
+                    ti.atomic_max(self.hi[k], pos[i][k])
+        for _ in range(1):   # serial: cell side and dimensions that fit in max_cells
+            h = min_side
+            if self.lo[0] > self.hi[0]:       # no live particle
+                for k in ti.static(range(d)):
+                    self.lo[k] = 0.0
+                    self.hi[k] = 0.0
+            cells = 1.0
+            for k in ti.static(range(d)):
+                cells *= (self.hi[k] - self.lo[k]) / h + 2.0
+            while cells > self.max_cells:
+                h *= ti.max(1.01, (cells / self.max_cells) ** (1.0 / d))
+                cells = 1.0
+                for k in ti.static(range(d)):
+                    cells *= (self.hi[k] - self.lo[k]) / h + 2.0
+            total = 1
+            for k in ti.static(range(d)):
+                self.origin[k] = self.lo[k] - 0.5 * h
+                self.dims[k] = ti.cast(ti.floor((self.hi[k] - self.origin[k]) / h), ti.i32) + 1
+                total *= self.dims[k]
+            self.side[None] = h
+            self.num_cells[None] = total
+
+    @ti.kernel
+    def _sort(self):
+        pos, kind = ti.static(self.state.pos, self.state.kind)
+        for c in range(self.num_cells[None]):
+            self.cell_count[c] = 0
+        for i in range(self.state.n[None]):
+            if kind[i] != GONE:
+                c = self.linear(self.cell_of(pos[i]))
+                self.particle_cell[i] = c
+                self.rank[i] = ti.atomic_add(self.cell_count[c], 1)
+            else:
+                self.particle_cell[i] = -1
+        # blocked exclusive prefix sum of cell_count into cell_start
+        for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+            s = 0
+            for c in range(b * SCAN_BLOCK, ti.min(self.num_cells[None], (b + 1) * SCAN_BLOCK)):
+                s += self.cell_count[c]
+            self.block_sum[b] = s
+        for _ in range(1):
+            run = 0
+            for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+                s = self.block_sum[b]
+                self.block_sum[b] = run
+                run += s
+            self.n_live[None] = run
+            self.cell_start[self.num_cells[None]] = run
+            self.n_parked[None] = 0
+        for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+            run = self.block_sum[b]
+            for c in range(b * SCAN_BLOCK, ti.min(self.num_cells[None], (b + 1) * SCAN_BLOCK)):
+                self.cell_start[c] = run
+                run += self.cell_count[c]
+        # scatter; parked particles go after the live ones so a permutation keeps them
+        for i in range(self.state.n[None]):
+            c = self.particle_cell[i]
+            if c >= 0:
+                self.order[self.cell_start[c] + self.rank[i]] = i
+            else:
+                self.order[self.n_live[None] + ti.atomic_add(self.n_parked[None], 1)] = i
+
+    @ti.kernel
+    def _identity_order(self):
+        for k in range(self.state.n[None]):
+            self.order[k] = k
+
+    # ---- functions used by the passes ----------------------------------------------------
+    @ti.func
+    def cell_of(self, x):
+        c = ti.Vector([0] * self.dim)
+        for k in ti.static(range(self.dim)):
+            ck = ti.cast(ti.floor((x[k] - self.origin[k]) / self.side[None]), ti.i32)
+            c[k] = ti.min(ti.max(ck, 0), self.dims[k] - 1)
+        return c
+
+    @ti.func
+    def linear(self, c):
+        idx = c[self.dim - 1]
+        for m in ti.static(range(self.dim - 1)):
+            k = self.dim - 2 - m
+            idx = idx * self.dims[k] + c[k]
+        return idx
+
+    @ti.func
+    def for_each_neighbour(self, i, xi, re2, task: ti.template(), acc: ti.template()):
+        """Call ``task(i, j, rij, r2, acc)`` for every live j != i with r2 = |rij|^2 < re2,
+        rij = x_j - x_i. Rows of 3 cells along axis 0 are contiguous in cell order."""
+        d = ti.static(self.dim)
+        c = self.cell_of(xi)
+        for off in ti.static(ti.grouped(ti.ndrange(*([(-1, 2)] * (d - 1))))):
+            row = c
+            inside = True
+            for k in ti.static(range(1, d)):
+                row[k] = c[k] + off[k - 1]
+                if row[k] < 0 or row[k] >= self.dims[k]:
+                    inside = False
+            if inside:
+                first = ti.max(c[0] - 1, 0)
+                last = ti.min(c[0] + 1, self.dims[0] - 1)
+                row[0] = first
+                a = self.linear(row)
+                for s in range(self.cell_start[a], self.cell_start[a + last - first + 1]):
+                    j = self.order[s]
+                    rij = self.state.pos[j] - xi
+                    r2 = rij.dot(rij)
+                    if r2 < re2 and j != i:
+                        task(i, j, rij, r2, acc)

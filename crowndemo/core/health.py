@@ -1,0 +1,146 @@
+"""Health of the run, reduced on the device every step: non-finite values, maximum speed,
+number-density excess, particles that left the domain (parked with a reason, counted), and
+kinetic + gravitational energy. ``check`` turns a broken limit into an ``InstabilityError``."""
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List
+
+import numpy as np
+import taichi as ti
+
+from .coefficients import Coefficients
+from .state import FLUID, GONE, ParticleState
+
+AXES = "xyz"
+F_SPEED2, F_EXCESS, F_KINETIC, F_POTENTIAL = range(4)
+I_NONFINITE = 0          # then one counter per exit reason
+
+
+@ti.func
+def finite(x) -> bool:
+    """Exponent bits not all set: neither Inf nor NaN (by bits, immune to fast-math)."""
+    ok = True
+    if ti.static(ti.lang.impl.get_runtime().default_fp == ti.f64):
+        ok = ((ti.bit_cast(x, ti.u64) >> 52) & 0x7FF) != 0x7FF
+    else:
+        ok = (ti.bit_cast(x, ti.u32) & 0x7F800000) != 0x7F800000
+    return ok
+
+
+def exit_reasons(dim: int) -> List[str]:
+    """Reason codes: 0 none, 1 + 2 axis + side for 'left through x-' etc."""
+    return ["none"] + [f"left through {AXES[a]}{s}" for a in range(dim) for s in "-+"]
+
+
+class InstabilityError(RuntimeError):
+    """The run broke a health limit; names the step, the time, what broke and a remedy."""
+
+    def __init__(self, step: int, time: float, what: str, binding: str, dt: float, remedy: str):
+        self.step, self.time, self.what, self.binding, self.dt, self.remedy = \
+            step, time, what, binding, dt, remedy
+        super().__init__(
+            f"unstable at step {step} (t = {time * 1e3:.4g} ms): {what}; the time step "
+            f"dt = {dt:.3g} s was bound by the {binding} limit. Remedy: {remedy}")
+
+
+@dataclass
+class HealthReport:
+    max_speed: float = 0.0
+    max_density_excess: float = 0.0
+    kinetic: float = 0.0
+    potential: float = 0.0
+    nonfinite: int = 0
+    left: Dict[str, int] = field(default_factory=dict)   # cumulative, by reason
+
+    @property
+    def energy(self) -> float:
+        return self.kinetic + self.potential
+
+    @property
+    def left_total(self) -> int:
+        return sum(self.left.values())
+
+
+@ti.data_oriented
+class Health:
+    def __init__(self, state: ParticleState, coef: Coefficients):
+        self.state, self.coef, self.dim = state, coef, state.dim
+        self.reasons = exit_reasons(self.dim)
+        self.fstats = ti.field(float, 4)
+        self.istats = ti.field(ti.i32, 1 + len(self.reasons))
+
+    def reset(self) -> None:
+        self.istats.fill(0)
+
+    @ti.kernel
+    def _reduce(self):
+        for k in ti.static(range(4)):
+            self.fstats[k] = 0.0
+        self.istats[I_NONFINITE] = 0
+        for i in range(self.state.n[None]):
+            if self.state.kind[i] == FLUID:
+                x, u = self.state.pos[i], self.state.vel[i]
+                bad = not finite(self.state.pressure[i])
+                for k in ti.static(range(self.dim)):
+                    if not (finite(x[k]) and finite(u[k])):
+                        bad = True
+                if bad:
+                    ti.atomic_add(self.istats[I_NONFINITE], 1)
+                else:
+                    reason = 0
+                    for k in ti.static(range(self.dim)):
+                        if x[k] < self.coef.domain_lo[None][k]:
+                            reason = 1 + 2 * k
+                        elif x[k] > self.coef.domain_hi[None][k]:
+                            reason = 2 + 2 * k
+                    if reason != 0:       # park it: out of the grid and the passes, counted
+                        self.state.kind[i] = GONE
+                        self.state.exit_reason[i] = reason
+                        self.state.vel[i] = ti.Vector.zero(float, self.dim)
+                        ti.atomic_add(self.istats[1 + reason], 1)
+                    else:
+                        m = self.coef.mass[None]
+                        u2 = u.dot(u)
+                        ti.atomic_max(self.fstats[F_SPEED2], u2)
+                        ti.atomic_max(self.fstats[F_EXCESS],
+                                      self.state.density[i] / self.coef.n0[None] - 1.0)
+                        ti.atomic_add(self.fstats[F_KINETIC], 0.5 * m * u2)
+                        ti.atomic_add(self.fstats[F_POTENTIAL], -m * self.coef.gravity[None].dot(x))
+
+    def measure(self) -> HealthReport:
+        self._reduce()
+        f, n = self.fstats.to_numpy(), self.istats.to_numpy()
+        return HealthReport(max_speed=math.sqrt(max(float(f[F_SPEED2]), 0.0)),
+                            max_density_excess=float(f[F_EXCESS]), kinetic=float(f[F_KINETIC]),
+                            potential=float(f[F_POTENTIAL]), nonfinite=int(n[I_NONFINITE]),
+                            left={r: int(c) for r, c in zip(self.reasons[1:], n[2:]) if c})
+
+    @staticmethod
+    def check(report: HealthReport, *, step: int, time: float, dt: float, binding: str,
+              sound_speed: float, max_mach: float, max_density_excess: float,
+              n_fluid: int, max_out_fraction: float) -> None:
+        """Raise InstabilityError for the first broken limit."""
+        remedy = ("lower the Courant/acoustic safety numbers (courant, acoustic), raise the "
+                  "sound speed, or refine l0; a user-fixed dt must respect the limits")
+        what = None
+        if report.nonfinite:
+            what = f"{report.nonfinite} fluid particles have non-finite position, velocity or pressure"
+        elif report.max_speed > max_mach * sound_speed:
+            what = (f"maximum speed {report.max_speed:.4g} m/s exceeds max_mach * c = "
+                    f"{max_mach * sound_speed:.4g} m/s (weak compressibility lost)")
+        elif report.max_density_excess > max_density_excess:
+            what = (f"number-density excess n/n0 - 1 = {report.max_density_excess:.3g} exceeds "
+                    f"the limit {max_density_excess:g}")
+        elif n_fluid and report.left_total > max_out_fraction * n_fluid:
+            what = (f"{report.left_total} of {n_fluid} fluid particles left the domain "
+                    f"({', '.join(f'{v} {k}' for k, v in report.left.items())}), over the "
+                    f"allowed fraction {max_out_fraction:g}")
+            remedy = "enlarge the domain, or check the scene's walls and initial speeds"
+        if what:
+            raise InstabilityError(step, time, what, binding, dt, remedy)
+
+
+def count_kinds(kind: np.ndarray) -> Dict[str, int]:
+    from .state import KIND_NAMES
+    return {name: int((kind == k).sum()) for k, name in KIND_NAMES.items()}

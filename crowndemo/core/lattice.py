@@ -1,0 +1,85 @@
+"""Constants of the explicit MPS model computed on a perfect cubic lattice (host side).
+
+n0 and lambda0 (method.md S13) and the surface-tension coefficient C (S23) depend only on the
+dimension, l0 and re, so they are computed here from lattice offsets, never from a scene.
+"""
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def weight(r: np.ndarray, re: float) -> np.ndarray:
+    """w(r) = re/r - 1 for 0 < r < re, else 0 (S10)."""
+    r = np.asarray(r, dtype=float)
+    out = np.zeros_like(r)
+    inside = (r > 0) & (r < re)
+    out[inside] = re / r[inside] - 1.0
+    return out
+
+
+def potential_shape(r: np.ndarray, l0: float, re: float) -> np.ndarray:
+    """Phi(r) = P(r)/C = (1/3)(r - 1.5 l0 + 0.5 re)(r - re)^2 for r <= re, else 0 (S22)."""
+    r = np.asarray(r, dtype=float)
+    return np.where(r <= re, (r - 1.5 * l0 + 0.5 * re) * (r - re) ** 2 / 3.0, 0.0)
+
+
+def lattice_offsets(dim: int, l0: float, reach: float) -> np.ndarray:
+    """All lattice vectors k*l0 (k integer, k != 0) with |k l0| < reach."""
+    m = int(math.ceil(reach / l0))
+    ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
+    ks = ks[np.any(ks != 0, axis=1)] * l0
+    return ks[np.linalg.norm(ks, axis=1) < reach]
+
+
+def n0_lambda0(dim: int, l0: float, re: float) -> tuple[float, float]:
+    """Reference number density n0 (S9 on the lattice) and lambda0 (S13)."""
+    r = np.linalg.norm(lattice_offsets(dim, l0, re), axis=1)
+    w = weight(r, re)
+    n0 = float(w.sum())
+    return n0, float((r ** 2 * w).sum() / n0)
+
+
+def cut_potential_sum(dim: int, l0: float, re: float) -> float:
+    """sum_{i in A} sum_{j across} Phi(r_ij) for a plane cut midway between lattice layers (S23).
+
+    A is the lattice column (0, ..., 0, -k l0), k >= 0, below the cut at z = l0/2; the partners
+    j are every lattice point with z >= l0 within re of it.
+    """
+    m = int(math.ceil(re / l0))
+    total = 0.0
+    for k in range(m + 1):                      # column particles deeper than re see nothing
+        zi = -k * l0
+        for off in lattice_offsets(dim, l0, re):
+            if zi + off[-1] > 0.5 * l0:           # partner on the other side of the cut
+                total += float(potential_shape(np.linalg.norm(off), l0, re))
+    return total
+
+
+def surface_tension_coefficient(dim: int, l0: float, re: float, sigma: float) -> float:
+    """C of the potential model (S23): 2 sigma l0^(d-1) = -C sum_A sum_j Phi(r_ij); C <= 0."""
+    if sigma == 0.0:
+        return 0.0
+    return -2.0 * sigma * l0 ** (dim - 1) / cut_potential_sum(dim, l0, re)
+
+
+@dataclass(frozen=True)
+class LatticeConstants:
+    dim: int
+    l0: float
+    re: float
+    n0: float
+    lambda0: float
+    C: float
+    mass: float   # rho l0^d (per unit depth in 2D)
+
+    @classmethod
+    def compute(cls, dim: int, l0: float, re_ratio: float, rho: float, sigma: float
+                ) -> "LatticeConstants":
+        re = re_ratio * l0
+        n0, lam = n0_lambda0(dim, l0, re)
+        return cls(dim, l0, re, n0, lam, surface_tension_coefficient(dim, l0, re, sigma),
+                   rho * l0 ** dim)

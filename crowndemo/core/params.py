@@ -1,0 +1,131 @@
+"""Parameters of one simulation: the liquid and resolution (Physics) and the numerics.
+
+Values are SI units. ``Model`` is the compile-time part (which terms exist); everything else is
+passed to the kernels at run time, so changing a value never recompiles.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields, replace
+from typing import Optional
+
+GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
+
+
+class ParameterError(ValueError):
+    """A parameter out of its allowed range, reported before any kernel runs."""
+
+    def __init__(self, key: str, value, allowed: str, source: str = "parameters"):
+        self.key, self.value, self.allowed, self.source = key, value, allowed, source
+        super().__init__(f"{source}: {key} = {value!r} is out of range; allowed: {allowed}")
+
+
+@dataclass(frozen=True)
+class Physics:
+    dim: int
+    l0: float                       # initial particle spacing [m]
+    v_max: float                    # expected maximum speed of the scene [m/s] (S5-S8)
+    re_ratio: float = 2.1           # re / l0 (S10)
+    rho: float = 998.0              # density [kg/m^3]
+    nu: float = 1.0e-6              # kinematic viscosity [m^2/s]
+    sigma: float = 0.0728           # surface tension [N/m]
+    gravity: float = 9.81           # along minus the last axis [m/s^2]
+    sound_speed: Optional[float] = None   # None: c = 5 v_max (S8)
+
+    @property
+    def c(self) -> float:
+        return self.sound_speed if self.sound_speed is not None else 5.0 * self.v_max
+
+    @property
+    def re(self) -> float:
+        return self.re_ratio * self.l0
+
+    def validate(self, source: str = "parameters") -> "Physics":
+        def need(cond: bool, key: str, allowed: str):
+            if not cond:
+                raise ParameterError(key, getattr(self, key), allowed, source)
+        need(self.dim in (2, 3), "dim", "2 or 3")
+        need(_finite(self.l0) and self.l0 > 0, "l0", "> 0 m")
+        need(_finite(self.v_max) and self.v_max > 0, "v_max", "> 0 m/s")
+        need(_finite(self.re_ratio) and 1.5 <= self.re_ratio <= 4.5, "re_ratio", "1.5 .. 4.5")
+        need(_finite(self.rho) and self.rho > 0, "rho", "> 0 kg/m^3")
+        need(_finite(self.nu) and self.nu >= 0, "nu", ">= 0 m^2/s")
+        need(_finite(self.sigma) and self.sigma >= 0, "sigma", ">= 0 N/m")
+        need(_finite(self.gravity), "gravity", "a finite number (m/s^2)")
+        need(self.sound_speed is None or (_finite(self.sound_speed) and self.sound_speed > 0),
+             "sound_speed", "> 0 m/s, or unset for 5 v_max")
+        return self
+
+
+@dataclass(frozen=True)
+class Numerics:
+    courant: float = 0.2            # velocity Courant v dt / l0 (S5)
+    acoustic: float = 1.0           # acoustic Courant c dt / l0 (S6)
+    viscous: float = 0.15           # nu dt / l0^2 (M1)
+    capillary: float = 1.0          # fraction of sqrt(rho l0^3 / (2 pi sigma)) (M1)
+    dt_max: float = math.inf        # cap, e.g. the frame interval [s]
+    fixed_dt: Optional[float] = None
+    allow_unsafe_dt: bool = False   # only for tests that force an unstable run
+    pressure_gradient: str = "pmin"
+    beta: Optional[float] = None    # free-surface threshold n < beta n0 (M3); None: 0.97/0.98
+    max_density_excess: float = 0.5  # abort when n/n0 - 1 exceeds this
+    max_mach: float = 1.0           # abort when a speed exceeds max_mach * c
+    max_out_fraction: float = 0.05  # abort when more fluid than this has left the domain
+    reorder_every: int = 1          # physical re-sort of particles by cell every N steps
+
+    def validate(self, source: str = "parameters") -> "Numerics":
+        def need(cond: bool, key: str, allowed: str):
+            if not cond:
+                raise ParameterError(key, getattr(self, key), allowed, source)
+        for key in ("courant", "acoustic", "viscous", "capillary"):
+            need(_finite(getattr(self, key)) and 0 < getattr(self, key) <= 2.0, key, "0 < x <= 2")
+        need(self.dt_max > 0, "dt_max", "> 0 s")
+        need(self.fixed_dt is None or (_finite(self.fixed_dt) and self.fixed_dt > 0),
+             "fixed_dt", "> 0 s, or unset for adaptive")
+        need(self.pressure_gradient in GRADIENT_FORMS, "pressure_gradient",
+             " | ".join(GRADIENT_FORMS))
+        need(self.beta is None or 0.5 <= self.beta < 1.0, "beta", "0.5 <= beta < 1")
+        need(self.max_density_excess > 0, "max_density_excess", "> 0")
+        need(self.max_mach > 0, "max_mach", "> 0")
+        need(0 <= self.max_out_fraction <= 1, "max_out_fraction", "0 .. 1")
+        need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
+             "an integer >= 0 (0: never)")
+        return self
+
+    def free_surface_beta(self, dim: int) -> float:
+        return self.beta if self.beta is not None else (0.97 if dim == 2 else 0.98)
+
+
+@dataclass(frozen=True)
+class Model:
+    """What is compiled into the step; a term that is off costs no work and no kernel."""
+    dim: int
+    viscosity: bool
+    surface_tension: bool
+    gravity: bool
+    pressure_gradient: str
+
+    @classmethod
+    def of(cls, physics: Physics, numerics: Numerics) -> "Model":
+        return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
+                   numerics.pressure_gradient)
+
+    def describe(self) -> dict:
+        return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
+                "gravity": self.gravity, "pressure_gradient": self.pressure_gradient}
+
+
+def _finite(x) -> bool:
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
+
+
+def with_values(obj, **changes):
+    """A copy of a Physics/Numerics with some values replaced (names checked)."""
+    names = {f.name for f in fields(obj)}
+    unknown = set(changes) - names
+    if unknown:
+        raise KeyError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
+    return replace(obj, **changes)
+
+
+__all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "with_values"]

@@ -1,0 +1,97 @@
+"""Per-particle fields in one registry, so that a re-sort permutes every one of them at once."""
+
+from typing import Dict
+
+import numpy as np
+import taichi as ti
+
+FLUID, WALL, DUMMY, GONE = 0, 1, 2, 3
+KIND_NAMES = {FLUID: "fluid", WALL: "wall", DUMMY: "dummy", GONE: "gone"}
+
+
+def field_nbytes(f) -> int:
+    """Bytes held by a Taichi field."""
+    elem = 8 if f.dtype in (ti.f64, ti.i64) else 4
+    comps = f.n * (f.m if hasattr(f, "m") else 1) if isinstance(f, ti.MatrixField) else 1
+    return int(np.prod(f.shape)) * comps * elem
+
+
+@ti.data_oriented
+class ParticleState:
+    """Fixed capacity, an active count, structure-of-arrays fields.
+
+    Persistent fields (position, velocity, pressure, number density, kind, id, exit reason) are
+    registered and permuted together by ``permute``; scratch fields are recomputed every step.
+    """
+
+    def __init__(self, dim: int, capacity: int):
+        self.dim, self.capacity = dim, int(capacity)
+        self.n = ti.field(ti.i32, shape=())           # active particles
+        self._persistent: Dict[str, ti.Field] = {}
+        self.pos = self._register("pos", ti.Vector.field(dim, float, self.capacity))
+        self.vel = self._register("vel", ti.Vector.field(dim, float, self.capacity))
+        self.pressure = self._register("pressure", ti.field(float, self.capacity))
+        self.density = self._register("number_density", ti.field(float, self.capacity))
+        self.kind = self._register("kind", ti.field(ti.i32, self.capacity))
+        self.pid = self._register("id", ti.field(ti.i32, self.capacity))
+        self.exit_reason = self._register("exit_reason", ti.field(ti.i32, self.capacity))
+        # scratch: one per element type, shared by the permutation and the step's passes
+        self.scratch_vec = ti.Vector.field(dim, float, self.capacity)
+        self.scratch_float = ti.field(float, self.capacity)
+        self.scratch_int = ti.field(ti.i32, self.capacity)
+
+    def _register(self, name: str, f):
+        self._persistent[name] = f
+        return f
+
+    @property
+    def count(self) -> int:
+        return int(self.n[None])
+
+    def nbytes_per_particle(self) -> int:
+        fields = list(self._persistent.values()) + [self.scratch_vec, self.scratch_float,
+                                                    self.scratch_int]
+        return sum(field_nbytes(f) for f in fields) // self.capacity
+
+    # ---- bulk load / read back ---------------------------------------------------------
+    def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
+        n = len(pos)
+        if n > self.capacity:
+            raise ValueError(f"{n} particles exceed the capacity {self.capacity}")
+        pad = lambda a, shape, dt: np.concatenate(
+            [np.asarray(a, dtype=dt).reshape((n,) + shape),
+             np.zeros((self.capacity - n,) + shape, dtype=dt)])
+        fdt = np.float64 if ti.lang.impl.current_cfg().default_fp == ti.f64 else np.float32
+        self.pos.from_numpy(pad(pos, (self.dim,), fdt))
+        self.vel.from_numpy(pad(vel, (self.dim,), fdt))
+        kinds = pad(kind, (), np.int32)
+        kinds[n:] = GONE
+        self.kind.from_numpy(kinds)
+        self.pid.from_numpy(np.arange(self.capacity, dtype=np.int32))
+        zero_f = np.zeros(self.capacity, dtype=fdt)
+        self.pressure.from_numpy(zero_f)
+        self.density.from_numpy(zero_f)
+        self.exit_reason.from_numpy(np.zeros(self.capacity, dtype=np.int32))
+        self.n[None] = n
+
+    def snapshot(self) -> Dict[str, np.ndarray]:
+        """Every persistent field as numpy, in particle-id order (independent of any re-sort)."""
+        n = self.count
+        pid = self.pid.to_numpy()[:n]
+        order = np.argsort(pid, kind="stable")
+        return {name: f.to_numpy()[:n][order] for name, f in self._persistent.items()}
+
+    # ---- the one permutation of every persistent field -----------------------------------
+    def permute(self, order: ti.Field) -> None:
+        """Field[k] <- Field[order[k]] for k < n, for every persistent field."""
+        for f in self._persistent.values():
+            scratch = (self.scratch_vec if isinstance(f, ti.MatrixField)
+                       else self.scratch_int if f.dtype == ti.i32 else self.scratch_float)
+            self._gather(f, scratch, order)
+
+    @ti.kernel
+    def _gather(self, f: ti.template(), scratch: ti.template(), order: ti.template()):
+        for k in range(self.n[None]):
+            scratch[k] = f[order[k]]
+        for k in range(self.n[None]):
+            f[k] = scratch[k]

@@ -1,0 +1,172 @@
+"""One explicit MPS step (method.md §3, S14-S21), assembled from the terms the scene uses, and
+the simulator that owns the fields and runs steps to an end time."""
+from __future__ import annotations
+
+import math
+import time as _time
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Callable, Dict, Optional, Sequence
+
+import numpy as np
+
+from . import timestep
+from .coefficients import Coefficients
+from .grid import CellGrid
+from .health import Health, HealthReport, count_kinds
+from .lattice import LatticeConstants
+from .operators import Operators
+from .params import Model, Numerics, Physics
+from .pressure import Pressure
+from .state import FLUID, ParticleState
+from .terms import Predictor
+
+
+@dataclass
+class RunStats:
+    steps: int = 0
+    time: float = 0.0
+    dt_min: float = math.inf
+    dt_max: float = 0.0
+    binding: Counter = field(default_factory=Counter)   # limit name -> steps it bound
+    wall_seconds: float = 0.0
+    energy_start: Optional[float] = None
+    health: HealthReport = field(default_factory=HealthReport)
+
+    def as_dict(self) -> dict:
+        h = self.health
+        return {"steps": self.steps, "time_s": self.time, "dt_min_s": self.dt_min,
+                "dt_max_s": self.dt_max, "binding_limits": dict(self.binding),
+                "wall_seconds": self.wall_seconds,
+                "health": {"max_speed_m_s": h.max_speed,
+                           "max_density_excess": h.max_density_excess,
+                           "energy_J": h.energy, "energy_start_J": self.energy_start,
+                           "left_domain": dict(h.left), "nonfinite": h.nonfinite}}
+
+
+class Simulator:
+    """Holds one compiled step. ``configure`` changes run-time values without recompiling;
+    the compiled terms (``Model``) are fixed at construction."""
+
+    def __init__(self, physics: Physics, numerics: Numerics, capacity: int,
+                 max_cells: Optional[int] = None):
+        physics.validate()
+        numerics.validate()
+        self.model = Model.of(physics, numerics)
+        dim = physics.dim
+        self.state = ParticleState(dim, capacity)
+        self.grid = CellGrid(self.state, max_cells or max(2 * capacity, 4096))
+        self.coef = Coefficients(dim)
+        self.operators = Operators(self.grid, self.coef)
+        self.predictor = Predictor(self.model, self.grid, self.coef)
+        self.pressure = Pressure(self.model, self.grid, self.coef)
+        self.health = Health(self.state, self.coef)
+        self.physics, self.numerics = physics, numerics
+        self.lattice = LatticeConstants.compute(dim, physics.l0, physics.re_ratio, physics.rho,
+                                                physics.sigma)
+        self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
+        self.stats = RunStats()
+        self.n_fluid = 0
+        self.configure(physics, numerics)
+
+    # ---- set-up --------------------------------------------------------------------------
+    def configure(self, physics: Physics, numerics: Numerics,
+                  domain: Optional[tuple] = None) -> None:
+        """New run-time values; the compiled model must stay the same."""
+        physics.validate()
+        numerics.validate()
+        model = Model.of(physics, numerics)
+        if model != self.model:
+            raise ValueError(f"compiled model {self.model} cannot run {model}; "
+                             "make a new Simulator")
+        timestep.check_fixed_dt(physics, numerics, model)
+        self.physics, self.numerics = physics, numerics
+        self.lattice = LatticeConstants.compute(physics.dim, physics.l0, physics.re_ratio,
+                                                physics.rho, physics.sigma)
+        if domain is not None:
+            self.domain = (tuple(domain[0]), tuple(domain[1]))
+        big = 1e30
+        lo = [max(v, -big) for v in self.domain[0]]
+        hi = [min(v, big) for v in self.domain[1]]
+        self.coef.set(physics, numerics, self.lattice, lo, hi)
+
+    def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
+        self.state.load(pos, vel, kind)
+        self.n_fluid = int((np.asarray(kind) == FLUID).sum())
+        self.health.reset()
+        self.stats = RunStats()
+        self._last = self._measure()
+        self.stats.energy_start = self._last.energy
+
+    # ---- the step ------------------------------------------------------------------------
+    def step(self, dt_cap: float = math.inf) -> float:
+        """Advance one step; returns dt. Raises InstabilityError on a broken health limit."""
+        dt, binding = timestep.choose(self.physics, self.numerics, self.model,
+                                      self._last.max_speed)
+        if dt_cap < dt:
+            dt, binding = dt_cap, "frame"
+        re = self.lattice.re
+        k = self.stats.steps
+        reorder = self.numerics.reorder_every > 0 and k % self.numerics.reorder_every == 0
+        if self.predictor.needs_neighbours:
+            self.grid.build(re, reorder=reorder)        # neighbours at r^k
+        self.predictor.run(dt)                          # S14-S16
+        self.grid.build(re, reorder=reorder and not self.predictor.needs_neighbours)  # at r*
+        self.pressure.density_and_pressure()            # S17 (M3)
+        self.pressure.correct(dt)                       # S18-S20
+        s = self.stats
+        s.steps += 1
+        s.time += dt
+        s.dt_min, s.dt_max = min(s.dt_min, dt), max(s.dt_max, dt)
+        s.binding[binding] += 1
+        self._last = self._measure()
+        Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
+                     sound_speed=self.physics.c, max_mach=self.numerics.max_mach,
+                     max_density_excess=self.numerics.max_density_excess,
+                     n_fluid=self.n_fluid, max_out_fraction=self.numerics.max_out_fraction)
+        return dt
+
+    def _measure(self) -> HealthReport:
+        report = self.health.measure()
+        self.stats.health = report
+        return report
+
+    def run(self, t_end: float, frame_times: Sequence[float] = (),
+            on_frame: Optional[Callable[["Simulator", int], None]] = None,
+            on_step: Optional[Callable[["Simulator"], None]] = None) -> RunStats:
+        """Step until t_end, landing exactly on each of ``frame_times`` and calling
+        ``on_frame(sim, index)`` there (frames at or before the current time fire at once)."""
+        start = _time.perf_counter()
+        frames = sorted(frame_times)
+        fi = 0
+        eps = 1e-12
+        try:
+            while True:
+                while fi < len(frames) and frames[fi] <= self.stats.time + eps:
+                    if on_frame:
+                        on_frame(self, fi)
+                    fi += 1
+                if self.stats.time >= t_end - eps:
+                    break
+                target = min(t_end, frames[fi]) if fi < len(frames) else t_end
+                self.step(dt_cap=target - self.stats.time)
+                if on_step:
+                    on_step(self)
+        finally:
+            self.stats.wall_seconds += _time.perf_counter() - start
+        return self.stats
+
+    # ---- output --------------------------------------------------------------------------
+    def refresh_pressure(self) -> None:
+        """P^{k+1} from n^{k+1} at the current positions (S21), for output only."""
+        self.grid.build(self.lattice.re, reorder=False)
+        self.pressure.density_and_pressure()
+
+    def snapshot(self) -> Dict[str, np.ndarray]:
+        return self.state.snapshot()
+
+    def counts(self) -> Dict[str, int]:
+        return count_kinds(self.state.kind.to_numpy()[: self.state.count])
+
+    def memory_bytes(self) -> int:
+        return self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()

@@ -1,0 +1,53 @@
+"""Time-step limits (method.md §1: S5-S8 and M1) and the choice of dt, naming the one that binds."""
+from __future__ import annotations
+
+import math
+from typing import Dict, Tuple
+
+from .params import Model, Numerics, ParameterError, Physics
+
+LIMIT_NAMES = ("courant", "acoustic", "viscous", "capillary", "dt_max")
+
+
+def limits(physics: Physics, numerics: Numerics, model: Model, speed: float) -> Dict[str, float]:
+    """Every limit on dt in force for this model at the given maximum speed.
+
+    courant:   C_v l0 / v        (S5, S7)
+    acoustic:  C_c l0 / c        (S6, S8)
+    viscous:   k_nu l0^2 / nu    (M1; only when viscosity is compiled in)
+    capillary: k_st sqrt(rho l0^3 / (2 pi sigma))  (M1; only with surface tension)
+    """
+    l0 = physics.l0
+    out = {"courant": numerics.courant * l0 / speed if speed > 0 else math.inf,
+           "acoustic": numerics.acoustic * l0 / physics.c}
+    if model.viscosity:
+        out["viscous"] = numerics.viscous * l0 * l0 / physics.nu
+    if model.surface_tension:
+        out["capillary"] = numerics.capillary * math.sqrt(
+            physics.rho * l0 ** 3 / (2.0 * math.pi * physics.sigma))
+    if math.isfinite(numerics.dt_max):
+        out["dt_max"] = numerics.dt_max
+    return out
+
+
+def choose(physics: Physics, numerics: Numerics, model: Model, speed: float
+           ) -> Tuple[float, str]:
+    """dt = the smallest limit (or the user's fixed dt), and the name of what binds."""
+    lim = limits(physics, numerics, model, speed)
+    name = min(lim, key=lim.get)
+    if numerics.fixed_dt is not None:
+        return numerics.fixed_dt, "fixed"
+    return lim[name], name
+
+
+def check_fixed_dt(physics: Physics, numerics: Numerics, model: Model, source: str = "parameters"
+                   ) -> None:
+    """Refuse a user-fixed dt that breaks a limit at the scene's expected speed, before any run."""
+    if numerics.fixed_dt is None or numerics.allow_unsafe_dt:
+        return
+    lim = limits(physics, numerics, model, physics.v_max)
+    for name, value in sorted(lim.items(), key=lambda kv: kv[1]):
+        if numerics.fixed_dt > value and name != "dt_max":
+            raise ParameterError("fixed_dt", numerics.fixed_dt,
+                                 f"<= {value:.3g} s (the {name} limit at v_max = "
+                                 f"{physics.v_max:g} m/s)", source)
