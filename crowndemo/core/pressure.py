@@ -24,11 +24,17 @@ def equation_of_state(n, n0, c2, rho, beta):
     return p
 
 
+def _gradient_sums(dim: int):
+    return ti.types.struct(pg=ti.types.vector(dim, float), g=ti.types.vector(dim, float),
+                           pmin=float)
+
+
 @ti.data_oriented
 class Pressure:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
         self.dim = model.dim
+        self.sums = _gradient_sums(self.dim)
 
     @ti.func
     def _density_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -49,34 +55,36 @@ class Pressure:
                 self.state.pressure[i] = equation_of_state(acc, n0, c2, rho, beta)
 
     @ti.func
-    def _pmin_pair(self, i, j, rij, r2, acc: ti.template()):
-        if self.state.kind[j] != DUMMY:
-            acc = ti.min(acc, self.state.pressure[j])
-
-    @ti.func
     def _gradient_pair(self, i, j, rij, r2, acc: ti.template()):
+        """Accumulates, in one walk, sum P_j g_ij, sum g_ij (g_ij = r_ij w / r^2) and the least
+        neighbour pressure, so every form of (M2) needs a single neighbour pass:
+        sum (P_j - P_ref) g_ij = sum P_j g_ij - P_ref sum g_ij."""
         if self.state.kind[j] != DUMMY:
-            acc += gradient_pair(self.state.pressure[j] - self.state.scratch_float[i], rij, r2,
-                                 weight(ti.sqrt(r2), self.coef.re[None]))
+            p_j = self.state.pressure[j]
+            g = gradient_pair(1.0, rij, r2, weight(ti.sqrt(r2), self.coef.re[None]))
+            acc.pg += p_j * g
+            acc.g += g
+            if ti.static(self.model.pressure_gradient == "pmin"):
+                acc.pmin = ti.min(acc.pmin, p_j)
 
     @ti.kernel
     def correct(self, dt: float):
-        """a' = -(1/rho) <grad P> (S18); u += dt a' (S19); r += dt^2 a' (S20)."""
-        for i in range(self.state.n[None]):       # the pressure each i subtracts: P_i, Pmin_i or -P_i
-            if self.state.kind[i] == FLUID:
-                p_ref = self.state.pressure[i]
-                if ti.static(self.model.pressure_gradient == "pmin"):
-                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                                 self._pmin_pair, p_ref)
-                elif ti.static(self.model.pressure_gradient == "sum"):
-                    p_ref = -p_ref
-                self.state.scratch_float[i] = p_ref
+        """a' = -(1/rho) <grad P> (S18); u += dt a' (S19); r += dt^2 a' (S20).
+        P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum)."""
         for i in range(self.state.n[None]):
             if self.state.kind[i] == FLUID:
-                acc = ti.Vector.zero(float, self.dim)
+                p_i = self.state.pressure[i]
+                acc = self.sums(pg=ti.Vector.zero(float, self.dim),
+                                   g=ti.Vector.zero(float, self.dim), pmin=p_i)
                 self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                              self._gradient_pair, acc)
-                self.state.scratch_vec[i] = -self.dim / (self.coef.n0[None] * self.coef.rho[None]) * acc
+                p_ref = p_i
+                if ti.static(self.model.pressure_gradient == "pmin"):
+                    p_ref = acc.pmin
+                elif ti.static(self.model.pressure_gradient == "sum"):
+                    p_ref = -p_i
+                grad = self.dim / self.coef.n0[None] * (acc.pg - p_ref * acc.g)
+                self.state.scratch_vec[i] = -grad / self.coef.rho[None]
         for i in range(self.state.n[None]):
             if self.state.kind[i] == FLUID:
                 self.state.vel[i] += dt * self.state.scratch_vec[i]

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import time as _time
+from array import array
 from collections import Counter
 from dataclasses import dataclass, field
 from typing import Callable, Dict, Optional, Sequence
@@ -22,6 +23,9 @@ from .state import FLUID, ParticleState
 from .terms import Predictor
 
 
+BINDINGS = timestep.LIMIT_NAMES + ("fixed", "frame")   # codes of RunStats.bound_log
+
+
 @dataclass
 class RunStats:
     steps: int = 0
@@ -29,6 +33,8 @@ class RunStats:
     dt_min: float = math.inf
     dt_max: float = 0.0
     binding: Counter = field(default_factory=Counter)   # limit name -> steps it bound
+    dt_log: array = field(default_factory=lambda: array("d"))     # dt of every step
+    bound_log: array = field(default_factory=lambda: array("B"))  # its binding limit (index)
     wall_seconds: float = 0.0
     energy_start: Optional[float] = None
     health: HealthReport = field(default_factory=HealthReport)
@@ -117,8 +123,11 @@ class Simulator:
         s = self.stats
         s.steps += 1
         s.time += dt
-        s.dt_min, s.dt_max = min(s.dt_min, dt), max(s.dt_max, dt)
+        if binding != "frame":      # a step cut short to land on a frame is not a limit
+            s.dt_min, s.dt_max = min(s.dt_min, dt), max(s.dt_max, dt)
         s.binding[binding] += 1
+        s.dt_log.append(dt)
+        s.bound_log.append(BINDINGS.index(binding))
         self._last = self._measure()
         Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
                      sound_speed=self.physics.c, max_mach=self.numerics.max_mach,

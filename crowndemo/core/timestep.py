@@ -46,8 +46,10 @@ def check_fixed_dt(physics: Physics, numerics: Numerics, model: Model, source: s
     if numerics.fixed_dt is None or numerics.allow_unsafe_dt:
         return
     lim = limits(physics, numerics, model, physics.v_max)
-    for name, value in sorted(lim.items(), key=lambda kv: kv[1]):
-        if numerics.fixed_dt > value and name != "dt_max":
-            raise ParameterError("fixed_dt", numerics.fixed_dt,
-                                 f"<= {value:.3g} s (the {name} limit at v_max = "
-                                 f"{physics.v_max:g} m/s)", source)
+    broken = sorted((v, k) for k, v in lim.items() if numerics.fixed_dt > v and k != "dt_max")
+    if broken:
+        names = " and ".join(k for _, k in broken)
+        raise ParameterError("fixed_dt", numerics.fixed_dt,
+                             f"<= {broken[0][0]:.3g} s (it breaks the {names} limit"
+                             f"{'s' if len(broken) > 1 else ''} at v_max = {physics.v_max:g} m/s)",
+                             source)

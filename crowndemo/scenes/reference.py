@@ -27,7 +27,8 @@ def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, dept
     v_max = physics.pop("v_max", math.sqrt(2.0 * g * depth))
     ph = Physics(dim=dim, l0=l0, v_max=v_max, gravity=g,
                  **{**WATER, "sigma": 0.0, "nu": nu, **physics})
-    inner_hi = [width] * (dim - 1) + [depth + 4 * l0]
+    # walls reach above the surface: the start from zero pressure sloshes the surface up
+    inner_hi = [width] * (dim - 1) + [depth + max(4 * l0, 0.25 * depth)]
     fluid = lattice_block([0.0] * dim, [width] * (dim - 1) + [depth], l0)
     layers = wall_layers(ph.re_ratio)
     walls = container_walls([0.0] * dim, inner_hi, l0, layers, _walls_faces(dim))

@@ -1,0 +1,216 @@
+"""Throughput of the full explicit MPS step on a 3D block of water resting in a tank.
+
+``run_one`` builds ``crowndemo.scenes.hydrostatic_tank(dim=3)`` with a fluid block of about N
+particles, warms up (the first step compiles the kernels, or loads them from Taichi's offline
+cache), then times a number of ``Simulator.step()`` calls. The rate counts fluid particles only:
+wall and dummy particles cost work (number density, pressure, neighbour walks) but are not
+counted in ``particle_steps_per_s``. ``record`` appends a Markdown section to BENCHMARKS.md.
+"""
+from __future__ import annotations
+
+import datetime
+import math
+import os
+import platform
+import subprocess
+import time
+from typing import Dict, List, Optional, Sequence, Tuple
+
+DEFAULT_NS = (100_000, 300_000)
+DEFAULT_STEPS = 20
+DEFAULT_L0 = 1.0e-3
+WARMUP_STEPS = 2
+
+BENCHMARKS_HEADER = """\
+# Benchmarks
+
+Throughput of the full explicit MPS step, measured by `crowndemo bench` (code:
+`crowndemo/bench.py`). The scene is a cube-ish block of water resting in a 3D tank with walls
+(`crowndemo.scenes.hydrostatic_tank(dim=3)`, l0 = 1 mm, re = 2.1 l0, water with viscosity,
+no surface tension). One step is everything `Simulator.step()` does: cell-grid build with the
+re-sort of particles, the predictor (viscosity + gravity), a second grid build, number density
+and pressure, the pressure-gradient corrector (`pmin` form), and the health reduction with its
+read-back to the host that picks the next dt.
+
+- `fluid`: fluid particles; `total`: including wall and dummy particles (they cost work too).
+- `particle-steps/s` = fluid particles x timed steps / seconds.
+- The first steps are not timed: they compile the kernels (or load them from Taichi's offline
+  cache, so a repeat run shows a smaller `compile s`). `compile s` = first step - a normal step.
+- `bytes/particle` = `Simulator.memory_bytes()` / total particles (particle fields + cell grid).
+
+Sections are appended by `crowndemo bench --record`, newest last.
+"""
+
+
+def block_shape(n: int) -> Tuple[int, int]:
+    """(k, kz): a k x k x kz lattice block with k = round(n^(1/3)) and k^2 kz close to n."""
+    if n < 1:
+        raise ValueError("n must be >= 1")
+    k = max(1, round(n ** (1.0 / 3.0)))
+    kz = max(1, round(n / (k * k)))
+    return k, kz
+
+
+def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0) -> Dict:
+    """Benchmark one block of about ``n`` fluid particles on the running backend."""
+    import taichi as ti
+
+    from . import backend
+    from .core import simulator_for
+    from .scenes import hydrostatic_tank
+
+    be = backend.current()
+    k, kz = block_shape(n)
+    t0 = time.perf_counter()
+    scene = hydrostatic_tank(dim=3, l0=l0, width=k * l0, depth=kz * l0, re_ratio=2.1)
+    sim = simulator_for(scene)
+    ti.sync()
+    setup_s = time.perf_counter() - t0
+
+    warm = []
+    for _ in range(WARMUP_STEPS):
+        t = time.perf_counter()
+        sim.step()
+        ti.sync()
+        warm.append(time.perf_counter() - t)
+
+    t = time.perf_counter()
+    for _ in range(steps):
+        sim.step()
+    ti.sync()
+    seconds = time.perf_counter() - t
+
+    counts = sim.counts()
+    fluid = sim.n_fluid
+    total = sim.state.count
+    per_step = seconds / steps
+    return {
+        "n_requested": int(n),
+        "block": [k, k, kz],
+        "l0_m": l0,
+        "particles": {"fluid": fluid, "total": total, "wall": counts.get("wall", 0),
+                      "dummy": counts.get("dummy", 0)},
+        "steps": int(steps),
+        "seconds": seconds,
+        "seconds_per_step": per_step,
+        "particle_steps_per_s": fluid * steps / seconds if seconds > 0 else math.inf,
+        "compile_s": max(warm[0] - per_step, 0.0),
+        "first_step_s": warm[0],
+        "setup_s": setup_s,
+        "arch": be.arch,
+        "resolved_arch": be.resolved,
+        "precision": be.precision,
+        "single_thread": be.single_thread,
+        "bytes_per_particle": sim.memory_bytes() / total,
+        "dt_s": sim.stats.dt_max,
+    }
+
+
+def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
+        on_result=None) -> List[Dict]:
+    results = []
+    for n in ns:
+        r = run_one(n, steps, l0)
+        results.append(r)
+        if on_result:
+            on_result(r)
+    return results
+
+
+# ---- output ----------------------------------------------------------------------------------
+COLUMNS = ("fluid", "total", "steps", "seconds", "particle-steps/s", "compile s", "bytes/particle",
+           "arch", "precision")
+
+
+def _row(r: Dict) -> List[str]:
+    arch = r["arch"] if r["arch"] == r["resolved_arch"] else f"{r['arch']} ({r['resolved_arch']})"
+    return [f"{r['particles']['fluid']:,}", f"{r['particles']['total']:,}", str(r["steps"]),
+            f"{r['seconds']:.3f}", f"{r['particle_steps_per_s']:.3e}", f"{r['compile_s']:.2f}",
+            f"{r['bytes_per_particle']:.0f}", arch,
+            r["precision"] + (" 1-thread" if r["single_thread"] else "")]
+
+
+def markdown_table(results: Sequence[Dict]) -> str:
+    rows = [list(COLUMNS), ["---:"] * 7 + ["---", "---"]] + [_row(r) for r in results]
+    return "\n".join("| " + " | ".join(row) + " |" for row in rows)
+
+
+def text_table(results: Sequence[Dict]) -> str:
+    rows = [list(COLUMNS)] + [_row(r) for r in results]
+    widths = [max(len(row[c]) for row in rows) for c in range(len(COLUMNS))]
+    lines = []
+    for i, row in enumerate(rows):
+        cells = [cell.rjust(w) if c < 7 else cell.ljust(w)
+                 for c, (cell, w) in enumerate(zip(row, widths))]
+        lines.append("  ".join(cells).rstrip())
+        if i == 0:
+            lines.append("  ".join("-" * w for w in widths))
+    return "\n".join(lines)
+
+
+# ---- the machine -----------------------------------------------------------------------------
+def cpu_model() -> str:
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.lower().startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine() or "unknown CPU"
+
+
+def usable_cores() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
+def gpu_name() -> Optional[str]:
+    try:
+        out = subprocess.run(["nvidia-smi", "--query-gpu=name", "--format=csv,noheader"],
+                             capture_output=True, text=True, timeout=10)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    names = [s.strip() for s in out.stdout.splitlines() if s.strip()]
+    return ", ".join(names) if out.returncode == 0 and names else None
+
+
+def machine() -> Dict:
+    import numpy
+    import taichi as ti
+
+    info = {"cpu": cpu_model(), "cores": os.cpu_count() or 1, "usable_cores": usable_cores(),
+            "python": platform.python_version(), "taichi": ".".join(map(str, ti.__version__)),
+            "numpy": numpy.__version__, "os": f"{platform.system()} {platform.release()}"}
+    gpu = gpu_name()
+    if gpu:
+        info["gpu"] = gpu
+    return info
+
+
+def record(results: Sequence[Dict], command: str, path: str) -> str:
+    """Append a Markdown section (machine, arch, date, command, table) to ``path``; returns it."""
+    m = machine()
+    be = results[0]
+    now = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    arch = be["arch"] if be["arch"] == be["resolved_arch"] else \
+        f"{be['arch']} ({be['resolved_arch']})"
+    cores = f"{m['cores']} cores" + (f" ({m['usable_cores']} usable)"
+                                     if m["usable_cores"] != m["cores"] else "")
+    lines = [f"## {now}", "",
+             f"- machine: {m['cpu']}, {cores}" + (f"; GPU: {m['gpu']}" if "gpu" in m else ""),
+             f"- arch: {arch}; precision: {be['precision']}"
+             + ("; single thread" if be["single_thread"] else ""),
+             f"- software: taichi {m['taichi']}, python {m['python']}, numpy {m['numpy']}, "
+             f"{m['os']}",
+             f"- command: `{command}`",
+             "", markdown_table(results), ""]
+    section = "\n".join(lines)
+    new = not os.path.exists(path) or os.path.getsize(path) == 0
+    with open(path, "a") as f:
+        if new:
+            f.write(BENCHMARKS_HEADER)
+        f.write("\n" + section)
+    return section

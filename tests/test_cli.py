@@ -1,0 +1,98 @@
+"""The command line, called in-process (Taichi can only be initialised in the test process)."""
+import json
+
+import pytest
+
+from crowndemo.cli import main
+from crowndemo.core.lattice import n0_lambda0
+
+HELP = [[], ["info"], ["scene"], ["scene", "tank"], ["scene", "dam-break"], ["scene", "patch"],
+        ["bench"]]
+
+
+@pytest.mark.parametrize("cmd", HELP, ids=lambda c: " ".join(c) or "top")
+def test_help_exits_0(cmd, capsys):
+    assert main(cmd + ["--help"]) == 0
+    out = capsys.readouterr().out
+    assert "usage: crowndemo" in out
+    assert "examples:" in out
+
+
+def test_info_json_matches_lattice_and_limits(capsys):
+    assert main(["info", "--dim", "3", "--l0", "1e-4", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    n0, lam = n0_lambda0(3, 1e-4, 2.1 * 1e-4)
+    assert data["n0"] == n0
+    assert data["lambda0"] == lam
+    assert data["C"] < 0
+    c = data["sound_speed"]
+    assert c == pytest.approx(5.0 * data["speed"])
+    assert data["limits_s"]["acoustic"] == pytest.approx(1e-4 / c, rel=1e-12)
+    assert set(data["limits_s"]) == {"courant", "acoustic", "viscous", "capillary"}
+    assert data["binding"] in data["limits_s"]
+    assert data["dt_s"] == min(v for v in data["limits_s"].values() if v is not None)
+
+
+def test_info_table(capsys):
+    assert main(["info", "--dim", "2", "--l0", "1e-3", "--sound-speed", "20"]) == 0
+    out = capsys.readouterr().out
+    for word in ("n0", "lambda0", "courant", "acoustic", "viscous", "capillary", "binds"):
+        assert word in out
+
+
+@pytest.mark.parametrize("argv, key", [
+    (["info", "--dim", "4", "--l0", "1e-3"], "dim"),
+    (["info", "--dim", "3", "--l0", "-1"], "l0"),
+    (["info", "--dim", "3", "--l0", "1e-3", "--re-ratio", "9"], "re_ratio"),
+    (["info", "--dim", "3", "--l0", "nan"], "l0"),
+    (["info", "--dim", "3"], "--l0"),
+    (["info", "--dim", "3", "--l0", "x"], "--l0"),
+    (["scene", "dam-break", "--dim", "2", "--a", "-0.1"], "a"),
+    (["scene", "tank", "--a", "0.1"], "--a"),
+    (["bench", "--n", "0"], "n"),
+    (["nosuch"], "nosuch"),
+])
+def test_bad_input_exits_2_with_one_line(argv, key, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("crowndemo: error: ")
+    assert key in err
+    assert "Traceback" not in err
+    assert err.count("\n") == 1
+
+
+def test_bad_arch_from_environment(monkeypatch, capsys):
+    monkeypatch.setenv("CROWNDEMO_ARCH", "tpu")
+    assert main(["bench", "--n", "10", "--steps", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "crowndemo: error: " in err and "CROWNDEMO_ARCH" in err
+
+
+def test_bench_json(capsys):
+    assert main(["bench", "--n", "2000", "--steps", "3", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert isinstance(data, dict)
+    assert data["particle_steps_per_s"] > 0
+    assert abs(data["particles"]["fluid"] - 2000) < 100
+    assert data["particles"]["total"] > data["particles"]["fluid"]
+    assert data["steps"] == 3 and data["seconds"] > 0
+    assert data["compile_s"] >= 0
+    assert data["bytes_per_particle"] > 0
+    assert data["precision"] == "f32"
+
+
+def test_scene_dam_break_2d(capsys):
+    assert main(["scene", "dam-break", "--dim", "2", "--t-end", "0.005"]) == 0
+    out = capsys.readouterr().out
+    for word in ("fluid", "steps", "acoustic", "max speed", "energy", "left the domain",
+                 "wall time"):
+        assert word in out
+
+
+def test_scene_json(capsys):
+    assert main(["scene", "dam-break", "--dim", "2", "--t-end", "0.002", "--json",
+                 "--quiet"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["steps"] > 0 and data["time_s"] == pytest.approx(0.002)
+    assert data["particles"]["fluid"] == 5000
+    assert data["health"]["left_domain"] == {}

@@ -1,0 +1,217 @@
+"""Cell-grid neighbour search against an O(N^2) brute force (method.md §3: cells of side >= re).
+
+A test-only kernel walks ``grid.for_each_neighbour`` for every live particle and writes the
+neighbour indices it visits into a 2-D field; numpy compares the sets with all pairs closer
+than re. Pairs within a relative 1e-5 of re (where the f32 distance in the kernel and the f64
+distance here may disagree) may go either way; every other pair must match exactly.
+"""
+
+import numpy as np
+import pytest
+import taichi as ti
+
+from crowndemo.core import FLUID, GONE, Numerics, Physics, Simulator
+
+L0 = 1.0e-3
+RE_RATIO = 2.1
+RE = RE_RATIO * L0
+MAX_NBR = 160
+BAND = 1e-5          # relative band around re^2 left undecided
+
+
+class Walker:
+    """Records, for each particle i, the j that for_each_neighbour visits (count -1: not walked)."""
+
+    def __init__(self, sim: Simulator):
+        cap = sim.state.capacity
+        self.nbr = ti.field(ti.i32, (cap, MAX_NBR))
+        self.count = ti.field(ti.i32, cap)
+        nbr, count, grid, state = self.nbr, self.count, sim.grid, sim.state
+
+        @ti.func
+        def record(i, j, rij, r2, acc: ti.template()):
+            if acc < MAX_NBR:
+                nbr[i, acc] = j
+            acc += 1
+
+        @ti.kernel
+        def walk(re2: float):
+            for i in range(state.n[None]):
+                c = -1
+                if state.kind[i] != GONE:
+                    c = 0
+                    grid.for_each_neighbour(i, state.pos[i], re2, record, c)
+                count[i] = c
+
+        self._walk = walk
+
+    def pairs(self, re: float):
+        """Dict i -> list of j (field indices), and the counts."""
+        self._walk(re * re)
+        count = self.count.to_numpy()
+        nbr = self.nbr.to_numpy()
+        assert count.max() <= MAX_NBR, "test set-up: raise MAX_NBR"
+        return count, nbr
+
+
+CAPACITY = 800
+BIG = {2: 1 << 16, 3: 1 << 21}   # cells enough for a 100 re spread: the side stays re
+SMALL = 64                       # forces the cell side to grow
+
+
+@pytest.fixture(scope="module")
+def sims():
+    """One simulator (and walker) per (dim, max_cells), reloaded by each test: building a
+    simulator compiles its kernels, which is most of the cost here."""
+    cache = {}
+
+    def get(dim: int, max_cells: int):
+        if (dim, max_cells) not in cache:
+            physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0,
+                              gravity=0.0)
+            sim = Simulator(physics, Numerics(), CAPACITY, max_cells)
+            cache[dim, max_cells] = (sim, Walker(sim))
+        return cache[dim, max_cells]
+    return get
+
+
+def load(sims, dim: int, max_cells: int, pos: np.ndarray, kind: np.ndarray):
+    sim, walker = sims(dim, max_cells)
+    sim.load(pos, np.zeros_like(pos), kind)
+    return sim, walker
+
+
+def brute_force(pos: np.ndarray, kind: np.ndarray, re: float):
+    """(sure, maybe) boolean matrices: pairs (i, j), both live, i != j, with r^2 below
+    re^2 (1 - BAND) (must be found) and below re^2 (1 + BAND) (may be found)."""
+    live = kind != GONE
+    d = pos[None, :, :] - pos[:, None, :]
+    r2 = (d ** 2).sum(axis=2)
+    ok = live[:, None] & live[None, :] & ~np.eye(len(pos), dtype=bool)
+    return ok & (r2 < re * re * (1 - BAND)), ok & (r2 < re * re * (1 + BAND))
+
+
+def check_against_brute_force(sim: Simulator, walker: Walker, pos_f: np.ndarray,
+                              kind: np.ndarray, ids=None):
+    """``ids[k]``: the original particle index held at field index k (identity if None)."""
+    n = len(pos_f)
+    ids = np.arange(n) if ids is None else ids
+    count, nbr = walker.pairs(RE)
+    sure, maybe = brute_force(pos_f, kind, RE)
+    found = np.zeros((n, n), dtype=bool)
+    for k in range(n):
+        i = ids[k]
+        if kind[i] == GONE:
+            assert count[k] == -1
+            continue
+        js = ids[nbr[k, :count[k]]]
+        assert len(set(js.tolist())) == len(js), f"particle {i}: a neighbour visited twice"
+        found[i, js] = True
+    missing = sure & ~found
+    extra = found & ~maybe
+    assert not missing.any(), f"missed pairs: {np.argwhere(missing)[:10].tolist()}"
+    assert not extra.any(), f"spurious pairs: {np.argwhere(extra)[:10].tolist()}"
+    assert (found != sure).sum() <= 2, "too many pairs at the re boundary to be rounding"
+    return found
+
+
+def random_cloud(dim: int, seed: int, n_box: int, box_re: float, far_re: float):
+    """Uniform particles in a box box_re*re wide, plus small clusters far_re*re away in
+    several directions (2D: +-x, +-y; 3D: +x, -y, +z) and an isolated pair far away."""
+    rng = np.random.default_rng(seed)
+    centre = np.full(dim, 0.5 * box_re * RE)
+    far = far_re * RE
+    shifts = ([(far, 0), (-far, 0), (0, far), (0, -far)] if dim == 2
+              else [(far, 0, 0), (0, -far, 0), (0, 0, far)])
+    parts = [rng.uniform(0.0, box_re * RE, size=(n_box, dim))]
+    for shift in shifts:
+        parts.append(centre + np.array(shift) + rng.uniform(-RE, RE, size=(12, dim)))
+    loner = centre + np.array(shifts[0]) + 0.5 * far * np.eye(dim)[1]
+    parts.append(loner[None, :])                                   # one isolated particle
+    parts.append(loner[None, :] + 0.6 * RE * np.eye(dim)[0])       # and its only partner
+    return np.concatenate(parts)
+
+
+def as_loaded(sim: Simulator) -> np.ndarray:
+    """Positions as the device holds them (f32 or f64), in float64 for the brute force."""
+    return sim.state.pos.to_numpy()[: sim.state.count].astype(np.float64)
+
+
+# sizes: 2D 600 particles in 12 re, 3D 700 in 7 re (about 13 and 9 neighbours each)
+CLOUD = {2: dict(n_box=600, box_re=12.0), 3: dict(n_box=700, box_re=7.0)}
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_neighbours_match_brute_force_far_outliers(sims, dim):
+    pos = random_cloud(dim, seed=10 + dim, far_re=100.0, **CLOUD[dim])
+    kind = np.full(len(pos), FLUID, dtype=np.int32)
+    # enough cells for 100 re spread in every axis: the cell side stays re
+    sim, walker = load(sims, dim, BIG[dim], pos, kind)
+    sim.grid.build(RE)
+    assert sim.grid.side[None] == pytest.approx(RE, rel=1e-6)
+    found = check_against_brute_force(sim, walker, as_loaded(sim), kind)
+    assert found[len(pos) - 2, len(pos) - 1] and found[len(pos) - 1, len(pos) - 2]
+    assert found.sum(axis=1).mean() > 5
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_neighbours_when_cell_side_must_grow(sims, dim):
+    pos = random_cloud(dim, seed=20 + dim, far_re=100.0, **CLOUD[dim])
+    kind = np.full(len(pos), FLUID, dtype=np.int32)
+    sim, walker = load(sims, dim, SMALL, pos, kind)
+    sim.grid.build(RE)
+    side = sim.grid.side[None]
+    assert side > 10 * RE, "the spread should force a larger cell side"
+    assert sim.grid.num_cells[None] <= SMALL
+    check_against_brute_force(sim, walker, as_loaded(sim), kind)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_gone_particles_are_excluded(sims, dim):
+    rng = np.random.default_rng(30 + dim)
+    pos = random_cloud(dim, seed=30 + dim, far_re=20.0, **CLOUD[dim])
+    kind = rng.choice(np.array([FLUID, FLUID, FLUID, 1, 2, GONE], dtype=np.int32), len(pos))
+    kind[-2:] = FLUID
+    # a parked particle very far away must not widen the grid either
+    pos = np.concatenate([pos, np.full((1, dim), 1.0e4)])
+    kind = np.concatenate([kind, np.array([GONE], dtype=np.int32)])
+    sim, walker = load(sims, dim, BIG[dim], pos, kind)
+    sim.grid.build(RE)
+    assert sim.grid.side[None] == pytest.approx(RE, rel=1e-6)
+    assert (kind == GONE).sum() > 50
+    found = check_against_brute_force(sim, walker, as_loaded(sim), kind)
+    assert not found[:, kind == GONE].any() and not found[kind == GONE, :].any()
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_neighbours_after_reorder(sims, dim):
+    """build(reorder=True) permutes every field into cell order; neighbour sets by particle
+    id are unchanged and the snapshot (id order) gives back the loaded particles."""
+    pos = random_cloud(dim, seed=40 + dim, far_re=30.0, **CLOUD[dim])
+    rng = np.random.default_rng(40 + dim)
+    kind = np.where(rng.uniform(size=len(pos)) < 0.1, GONE, FLUID).astype(np.int32)
+    sim, walker = load(sims, dim, BIG[dim], pos, kind)
+    before = as_loaded(sim)
+    sim.grid.build(RE, reorder=True)
+    pid = sim.state.pid.to_numpy()[: len(pos)]
+    assert sorted(pid.tolist()) == list(range(len(pos)))
+    assert not np.array_equal(pid, np.arange(len(pos))), "random particles should be re-sorted"
+    snap = sim.snapshot()
+    np.testing.assert_array_equal(snap["pos"].astype(np.float64), before)
+    np.testing.assert_array_equal(snap["kind"], kind)
+    check_against_brute_force(sim, walker, before, kind, ids=pid)
+
+
+def test_single_and_empty_live_sets(sims):
+    """One live particle has no neighbours; all parked: nothing is walked."""
+    pos = np.array([[0.0, 0.0], [0.5 * RE, 0.0], [3.0, 3.0]])
+    kind = np.array([FLUID, GONE, GONE], dtype=np.int32)
+    sim, w = load(sims, 2, BIG[2], pos, kind)
+    sim.grid.build(RE)
+    count, _ = w.pairs(RE)
+    assert count[:3].tolist() == [0, -1, -1]
+    sim.state.kind.from_numpy(np.full(sim.state.capacity, GONE, dtype=np.int32))
+    sim.grid.build(RE)
+    count, _ = w.pairs(RE)
+    assert count[:3].tolist() == [-1, -1, -1]
+    assert sim.grid.n_live[None] == 0
