@@ -1,0 +1,89 @@
+"""The seed's milk-crown scene (method.md §6): a drop of diameter D falling at speed U onto a
+film of thickness h on a square floor, in 3D or as a 2D cross-section (a cylinder-drop slice).
+
+What the scene does not need is left out, and said so in ``info["left_out"]``: the film beyond
+the radius the impact can disturb before the end time (its edge is then a free edge at rest),
+the side walls when the liquid cannot reach them, and the surface-tension and viscosity terms
+when their coefficients are zero (the compiled model drops them).
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from ..core.params import Numerics, Physics
+from .base import Scene, assemble, container_walls, lattice_block, wall_layers
+
+
+def crown_base_radius(t: float, U: float, D: float, h: float) -> float:
+    """Yarin & Weiss (1995): R_c/D = (2/(3 delta))^(1/4) sqrt(tau), tau = t U / D, delta = h/D
+    (method.md §7, tau0 = 0)."""
+    return D * (2.0 / (3.0 * h / D)) ** 0.25 * math.sqrt(max(t, 0.0) * U / D)
+
+
+def reach_radius(t_end: float, U: float, D: float, h: float, gap: float) -> float:
+    """How far from the axis the liquid can be disturbed by t_end: twice the crown base radius
+    at the end time (the film ahead of the crown is pushed too), at least the drop, plus 2 mm."""
+    t_impact = gap / U
+    return max(2.0 * crown_base_radius(t_end - t_impact, U, D, h), D) + 2.0e-3
+
+
+def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 1.0e-2,
+          speed: float = 8.0, gap: float = 1.0e-3, floor: float = 0.09, t_end: float = 4.0e-3,
+          trim: bool = True, numerics: Optional[Numerics] = None, rho: float = 998.0,
+          nu: float = 1.0e-6, sigma: float = 0.0728, gravity: float = 9.81,
+          sound_speed: Optional[float] = None, re_ratio: float = 2.1) -> Scene:
+    """Drop on a film. ``floor`` is the side of the square container floor (the width of the
+    slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0."""
+    physics = Physics(dim=dim, l0=l0, v_max=speed, re_ratio=re_ratio, rho=rho, nu=nu,
+                      sigma=sigma, gravity=gravity, sound_speed=sound_speed)
+    half = floor / 2.0
+    reach = reach_radius(t_end, speed, drop, film, gap)
+    trimmed = trim and reach < half
+    extent = reach if trimmed else half
+    # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D)
+    film_pts = lattice_block([-extent] * (dim - 1) + [0.0], [extent] * (dim - 1) + [film], l0)
+    if trimmed and dim == 3:
+        film_pts = film_pts[np.linalg.norm(film_pts[:, :2], axis=1) <= extent]
+    # the drop: lattice points inside the sphere (disc), its bottom `gap` above the film
+    radius = drop / 2.0
+    centre_z = film + gap + radius
+    box = lattice_block([-radius] * (dim - 1) + [centre_z - radius],
+                        [radius] * (dim - 1) + [centre_z + radius], l0)
+    rel = box - np.array([0.0] * (dim - 1) + [centre_z])
+    drop_pts = box[np.linalg.norm(rel, axis=1) <= radius]
+    fluid = np.concatenate([film_pts, drop_pts])
+    vel = np.zeros_like(fluid)
+    vel[len(film_pts):, -1] = -speed
+    # walls: the floor under the film; side walls only if the liquid can reach them
+    layers = wall_layers(re_ratio)
+    faces = ["z-"] if dim == 3 else ["y-"]
+    if not trimmed:
+        faces += ["x-", "x+"] + (["y-", "y+"] if dim == 3 else [])
+    wall_top = film + 0.5 * drop
+    floor_lo = [-extent - (0 if not trimmed else layers * l0)] * (dim - 1) + [0.0]
+    floor_hi = [extent + (0 if not trimmed else layers * l0)] * (dim - 1) + [wall_top]
+    walls = container_walls(floor_lo, floor_hi, l0, layers, faces)
+    if trimmed and dim == 3:   # only the disc under the film (and a rim of `layers` l0)
+        keep = np.linalg.norm(walls[0][:, :2], axis=1) <= extent + layers * l0
+        walls = (walls[0][keep], walls[1][keep])
+    margin = (layers + 1) * l0
+    top = centre_z + radius + speed * t_end + 0.05
+    domain = (tuple([-half - margin] * (dim - 1) + [-margin]),
+              tuple([half + margin] * (dim - 1) + [top]))
+    left_out = []
+    if trimmed:
+        left_out.append(f"film beyond r = {extent * 1e3:.1f} mm (of {half * 1e3:.0f} mm): the "
+                        "impact cannot disturb it before t_end; its edge is free")
+        left_out.append("side walls: the liquid cannot reach them before t_end")
+    if sigma == 0:
+        left_out.append("surface tension term (sigma = 0)")
+    if nu == 0:
+        left_out.append("viscosity term (nu = 0)")
+    info = {"scene": "crown", "film_m": film, "drop_m": drop, "speed_m_s": speed, "gap_m": gap,
+            "floor_m": floor, "extent_m": extent, "trimmed": trimmed, "walls": faces,
+            "n_film": int(len(film_pts)), "n_drop": int(len(drop_pts)), "left_out": left_out}
+    return assemble("crown", physics, numerics or Numerics(), fluid, vel, walls, domain, t_end,
+                    info)
