@@ -55,7 +55,7 @@ class Walker:
 
 
 CAPACITY = 800
-BIG = {2: 1 << 16, 3: 1 << 21}   # cells enough for a 100 re spread: the side stays re
+BIG = {2: 1 << 18, 3: 1 << 24}   # cells enough for a 100 re spread: the side stays re/reach
 SMALL = 64                       # forces the cell side to grow
 
 
@@ -145,10 +145,10 @@ CLOUD = {2: dict(n_box=600, box_re=12.0), 3: dict(n_box=700, box_re=7.0)}
 def test_neighbours_match_brute_force_far_outliers(sims, dim):
     pos = random_cloud(dim, seed=10 + dim, far_re=100.0, **CLOUD[dim])
     kind = np.full(len(pos), FLUID, dtype=np.int32)
-    # enough cells for 100 re spread in every axis: the cell side stays re
+    # enough cells for 100 re spread in every axis: the cell side stays re / reach
     sim, walker = load(sims, dim, BIG[dim], pos, kind)
     sim.grid.build(RE)
-    assert sim.grid.side[None] == pytest.approx(RE, rel=1e-6)
+    assert sim.grid.side[None] == pytest.approx(RE / sim.grid.reach, rel=1e-6)
     found = check_against_brute_force(sim, walker, as_loaded(sim), kind)
     assert found[len(pos) - 2, len(pos) - 1] and found[len(pos) - 1, len(pos) - 2]
     assert found.sum(axis=1).mean() > 5
@@ -177,7 +177,7 @@ def test_gone_particles_are_excluded(sims, dim):
     kind = np.concatenate([kind, np.array([GONE], dtype=np.int32)])
     sim, walker = load(sims, dim, BIG[dim], pos, kind)
     sim.grid.build(RE)
-    assert sim.grid.side[None] == pytest.approx(RE, rel=1e-6)
+    assert sim.grid.side[None] == pytest.approx(RE / sim.grid.reach, rel=1e-6)
     assert (kind == GONE).sum() > 50
     found = check_against_brute_force(sim, walker, as_loaded(sim), kind)
     assert not found[:, kind == GONE].any() and not found[kind == GONE, :].any()

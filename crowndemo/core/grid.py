@@ -1,9 +1,10 @@
-"""Dynamic cell grid: bounds follow the live particles, counting sort, 3^d neighbour walk.
+"""Dynamic cell grid: bounds follow the live particles, counting sort, neighbour walk.
 
 The grid is rebuilt from scratch whenever positions change: bounds by reduction, cell count per
 cell, a blocked two-level prefix sum that runs on the CPU and GPU archs alike (Taichi's
 PrefixSumExecutor does not run on the CPU), then a scatter into ``order`` (particle indices in
-cell order). Cells have side >= re, so every neighbour within re lies in the 3^d cells around.
+cell order). Cells have side >= re/k (k = ``cells_per_re``), so every neighbour within re lies
+in the (2k + 1)^d cells around; k = 2 visits fewer candidate pairs than k = 1 (BENCHMARKS.md).
 If the live particles spread so far that the cells would not fit in ``max_cells``, the cell side
 grows: the walk stays exact, only more candidate pairs are visited.
 """
@@ -17,8 +18,9 @@ SCAN_BLOCK = 1024
 
 @ti.data_oriented
 class CellGrid:
-    def __init__(self, state: ParticleState, max_cells: int):
+    def __init__(self, state: ParticleState, max_cells: int, cells_per_re: int = 2):
         d = self.dim = state.dim
+        self.reach = int(cells_per_re)      # cells of side re/reach; walk (2 reach + 1)^d
         self.state = state
         self.max_cells = int(max_cells)
         self.lo = ti.field(float, d)
@@ -32,6 +34,9 @@ class CellGrid:
         self.cell_count = ti.field(ti.i32, self.max_cells)
         self.cell_start = ti.field(ti.i32, self.max_cells + 1)
         self.block_sum = ti.field(ti.i32, (self.max_cells + SCAN_BLOCK - 1) // SCAN_BLOCK)
+        particle_blocks = (state.capacity + SCAN_BLOCK - 1) // SCAN_BLOCK
+        self.block_lo = ti.Vector.field(d, float, particle_blocks)
+        self.block_hi = ti.Vector.field(d, float, particle_blocks)
         self.particle_cell = ti.field(ti.i32, state.capacity)
         self.rank = ti.field(ti.i32, state.capacity)
         self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
@@ -44,7 +49,7 @@ class CellGrid:
     def build(self, min_side: float, reorder: bool = False) -> None:
         """Rebuild at the current positions; with ``reorder`` permute the particles into cell
         order (every persistent field, through the state's registry)."""
-        self._plan(min_side)
+        self._plan(min_side / self.reach)
         self._sort()
         if reorder:
             self.state.permute(self.order)
@@ -55,15 +60,24 @@ class CellGrid:
     def _plan(self, min_side: float):
         d = ti.static(self.dim)
         pos, kind = ti.static(self.state.pos, self.state.kind)
-        for k in ti.static(range(d)):
-            self.lo[k] = 3.0e38
-            self.hi[k] = -3.0e38
-        for i in range(self.state.n[None]):
-            if kind[i] != GONE:
-                for k in ti.static(range(d)):
-                    ti.atomic_min(self.lo[k], pos[i][k])
-                    ti.atomic_max(self.hi[k], pos[i][k])
+        # bounds of the live particles: per block, then over the blocks (no contended atomics)
+        for b in range((self.state.n[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+            lo = ti.Vector([3.0e38] * d)
+            hi = ti.Vector([-3.0e38] * d)
+            for i in range(b * SCAN_BLOCK, ti.min(self.state.n[None], (b + 1) * SCAN_BLOCK)):
+                if kind[i] != GONE:
+                    lo = ti.min(lo, pos[i])
+                    hi = ti.max(hi, pos[i])
+            self.block_lo[b] = lo
+            self.block_hi[b] = hi
         for _ in range(1):   # serial: cell side and dimensions that fit in max_cells
+            for k in ti.static(range(d)):
+                self.lo[k] = 3.0e38
+                self.hi[k] = -3.0e38
+            for b in range((self.state.n[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+                for k in ti.static(range(d)):
+                    self.lo[k] = ti.min(self.lo[k], self.block_lo[b][k])
+                    self.hi[k] = ti.max(self.hi[k], self.block_hi[b][k])
             h = min_side
             if self.lo[0] > self.hi[0]:       # no live particle
                 for k in ti.static(range(d)):
@@ -150,10 +164,12 @@ class CellGrid:
     @ti.func
     def for_each_neighbour(self, i, xi, re2, task: ti.template(), acc: ti.template()):
         """Call ``task(i, j, rij, r2, acc)`` for every live j != i with r2 = |rij|^2 < re2,
-        rij = x_j - x_i. Rows of 3 cells along axis 0 are contiguous in cell order."""
+        rij = x_j - x_i. Cells have side >= re/reach, so the (2 reach + 1)^d cells around hold
+        every neighbour; rows of 2 reach + 1 cells along axis 0 are contiguous in cell order."""
         d = ti.static(self.dim)
         c = self.cell_of(xi)
-        for off in ti.static(ti.grouped(ti.ndrange(*([(-1, 2)] * (d - 1))))):
+        k = ti.static(self.reach)
+        for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
             row = c
             inside = True
             for k in ti.static(range(1, d)):
@@ -161,8 +177,8 @@ class CellGrid:
                 if row[k] < 0 or row[k] >= self.dims[k]:
                     inside = False
             if inside:
-                first = ti.max(c[0] - 1, 0)
-                last = ti.min(c[0] + 1, self.dims[0] - 1)
+                first = ti.max(c[0] - k, 0)
+                last = ti.min(c[0] + k, self.dims[0] - 1)
                 row[0] = first
                 a = self.linear(row)
                 for s in range(self.cell_start[a], self.cell_start[a + last - first + 1]):

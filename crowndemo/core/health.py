@@ -15,6 +15,7 @@ from .state import FLUID, GONE, ParticleState
 AXES = "xyz"
 F_SPEED2, F_EXCESS, F_KINETIC, F_POTENTIAL = range(4)
 I_NONFINITE = 0          # then one counter per exit reason
+BLOCK = 1024             # particles per block of the two-level reduction
 
 
 @ti.func
@@ -69,44 +70,62 @@ class Health:
         self.reasons = exit_reasons(self.dim)
         self.fstats = ti.field(float, 4)
         self.istats = ti.field(ti.i32, 1 + len(self.reasons))
+        blocks = (state.capacity + BLOCK - 1) // BLOCK
+        self.block_stats = ti.Vector.field(4, float, blocks)
+        self.block_bad = ti.field(ti.i32, blocks)
 
     def reset(self) -> None:
         self.istats.fill(0)
 
     @ti.kernel
     def _reduce(self):
-        for k in ti.static(range(4)):
-            self.fstats[k] = 0.0
-        self.istats[I_NONFINITE] = 0
-        for i in range(self.state.n[None]):
-            if self.state.kind[i] == FLUID:
-                x, u = self.state.pos[i], self.state.vel[i]
-                bad = not finite(self.state.pressure[i])
-                for k in ti.static(range(self.dim)):
-                    if not (finite(x[k]) and finite(u[k])):
-                        bad = True
-                if bad:
-                    ti.atomic_add(self.istats[I_NONFINITE], 1)
-                else:
-                    reason = 0
+        """Per block of particles, then over the blocks: no contended atomics on the stats."""
+        for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
+            speed2, excess, kinetic, potential, bad_count = 0.0, 0.0, 0.0, 0.0, 0
+            m, n0 = self.coef.mass[None], self.coef.n0[None]
+            g = self.coef.gravity[None]
+            for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
+                if self.state.kind[i] == FLUID:
+                    x, u = self.state.pos[i], self.state.vel[i]
+                    bad = not finite(self.state.pressure[i])
                     for k in ti.static(range(self.dim)):
-                        if x[k] < self.coef.domain_lo[None][k]:
-                            reason = 1 + 2 * k
-                        elif x[k] > self.coef.domain_hi[None][k]:
-                            reason = 2 + 2 * k
-                    if reason != 0:       # park it: out of the grid and the passes, counted
-                        self.state.kind[i] = GONE
-                        self.state.exit_reason[i] = reason
-                        self.state.vel[i] = ti.Vector.zero(float, self.dim)
-                        ti.atomic_add(self.istats[1 + reason], 1)
+                        if not (finite(x[k]) and finite(u[k])):
+                            bad = True
+                    if bad:
+                        bad_count += 1
                     else:
-                        m = self.coef.mass[None]
-                        u2 = u.dot(u)
-                        ti.atomic_max(self.fstats[F_SPEED2], u2)
-                        ti.atomic_max(self.fstats[F_EXCESS],
-                                      self.state.density[i] / self.coef.n0[None] - 1.0)
-                        ti.atomic_add(self.fstats[F_KINETIC], 0.5 * m * u2)
-                        ti.atomic_add(self.fstats[F_POTENTIAL], -m * self.coef.gravity[None].dot(x))
+                        reason = 0
+                        for k in ti.static(range(self.dim)):
+                            if x[k] < self.coef.domain_lo[None][k]:
+                                reason = 1 + 2 * k
+                            elif x[k] > self.coef.domain_hi[None][k]:
+                                reason = 2 + 2 * k
+                        if reason != 0:       # park it: out of the grid and the passes, counted
+                            self.state.kind[i] = GONE
+                            self.state.exit_reason[i] = reason
+                            self.state.vel[i] = ti.Vector.zero(float, self.dim)
+                            ti.atomic_add(self.istats[1 + reason], 1)
+                        else:
+                            u2 = u.dot(u)
+                            speed2 = ti.max(speed2, u2)
+                            excess = ti.max(excess, self.state.density[i] / n0 - 1.0)
+                            kinetic += 0.5 * m * u2
+                            potential -= m * g.dot(x)
+            self.block_stats[b] = ti.Vector([speed2, excess, kinetic, potential])
+            self.block_bad[b] = bad_count
+        for _ in range(1):
+            total = ti.Vector([0.0, 0.0, 0.0, 0.0])
+            bad_total = 0
+            for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
+                v = self.block_stats[b]
+                total[F_SPEED2] = ti.max(total[F_SPEED2], v[F_SPEED2])
+                total[F_EXCESS] = ti.max(total[F_EXCESS], v[F_EXCESS])
+                total[F_KINETIC] += v[F_KINETIC]
+                total[F_POTENTIAL] += v[F_POTENTIAL]
+                bad_total += self.block_bad[b]
+            for k in ti.static(range(4)):
+                self.fstats[k] = total[k]
+            self.istats[I_NONFINITE] = bad_total
 
     def measure(self) -> HealthReport:
         self._reduce()
