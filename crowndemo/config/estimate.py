@@ -1,0 +1,214 @@
+"""Sizes and rough costs of a resolved preset, without running a kernel: particle counts (the
+scene built with numpy, or scaled from a coarser build when it would be large), steps to the
+end time, memory, and a run-time estimate from the throughput recorded in BENCHMARKS.md.
+
+Two figures measured on crown runs (2026-11-22, AMD EPYC, 2 cores, f32) correct the bench:
+
+- after the drop touches the film, the impact throws particles off at about 0.85 c (2m-drop
+  draft: 26.9 m/s at c = 31.3 m/s, and 52 m/s at c = 62.6 m/s; quick: 31.8 m/s at c = 40 m/s),
+  so from contact on the Courant limit binds at v ~ 0.85 c, not at the drop's speed U;
+- a crown step costs about twice a bench step per particle (2m-drop draft: 3.3 steps/s x
+  251,607 particles = 8.3e5 particle-steps/s; quick: 9.3e5; the bench: 1.6e6).
+
+``steps_to_end`` gives both the floor (dt at v = U all along) and the expected count.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Dict, Optional
+
+from ..core import timestep
+from .resolve import Resolved
+
+EXACT_UP_TO = 1.5e6          # total particles: build the scene itself up to this many
+SCALE_FROM = 5.0e5           # otherwise build about this many and scale
+# used when BENCHMARKS.md cannot be read (the 2026-11-22 CPU figures: AMD EPYC, 2 cores)
+FALLBACK_RATE = 8.0e5        # fluid particle-steps/s, 3D, f32
+FALLBACK_COMPILE_S = 5.0
+FALLBACK_BYTES = 92.0        # per particle (fields + cell grid), f32
+SPLASH_MACH = 0.85           # fastest particle / c after contact (measured, see above)
+CROWN_COST = 2.0             # a crown step's cost per particle / the bench's (measured)
+
+
+@dataclass(frozen=True)
+class Throughput:
+    rate: float              # fluid particle-steps/s of the bench's 3D tank
+    total_per_fluid: float   # the bench scene's (fluid + wall + dummy) / fluid
+    compile_s: float         # first-step compile time (an upper figure: the cache helps)
+    bytes_per_particle: float
+    source: str
+
+    @property
+    def rate_total(self) -> float:
+        """Particle-steps/s counting every particle (wall and dummy particles cost work)."""
+        return self.rate * self.total_per_fluid
+
+
+def benchmarks_path() -> Path:
+    import crowndemo
+    return Path(crowndemo.__file__).resolve().parent.parent / "BENCHMARKS.md"
+
+
+def throughput(path: Optional[Path] = None, rate: Optional[float] = None) -> Throughput:
+    """The newest CPU f32 figure of BENCHMARKS.md (its largest N); ``rate`` overrides it."""
+    found = _parse_benchmarks(path or benchmarks_path())
+    if found is None:
+        t = Throughput(FALLBACK_RATE, 1.3, FALLBACK_COMPILE_S, FALLBACK_BYTES,
+                       "built-in figure (BENCHMARKS.md not found)")
+    else:
+        t = found
+    if rate is not None:
+        t = Throughput(rate, t.total_per_fluid, t.compile_s, t.bytes_per_particle,
+                       f"--rate {rate:g}")
+    return t
+
+
+def _parse_benchmarks(path: Path) -> Optional[Throughput]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError:
+        return None
+    best = None
+    for section in re.split(r"^## ", text, flags=re.M)[1:]:
+        title = section.splitlines()[0].strip()
+        machine = re.search(r"^- machine: (.+)$", section, re.M)
+        rows = []
+        for line in section.splitlines():
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if len(cells) < 9 or not re.fullmatch(r"[\d,]+", cells[0]):
+                continue
+            try:
+                fluid, total = int(cells[0].replace(",", "")), int(cells[1].replace(",", ""))
+                rate, compile_s, bpp = float(cells[4]), float(cells[5]), float(cells[6])
+            except ValueError:
+                continue
+            if cells[7].startswith("cpu") and cells[8] == "f32":
+                rows.append((fluid, total, rate, compile_s, bpp))
+        if rows:
+            fluid, total, rate, compile_s, bpp = max(rows)
+            where = f"BENCHMARKS.md {title}"
+            if machine:
+                where += f", {machine.group(1).strip()}"
+            best = Throughput(rate, total / fluid, compile_s, bpp,
+                              f"{where}, N = {fluid:,}")
+    return best
+
+
+def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
+                    scale_from: float = SCALE_FROM) -> Dict:
+    """Particles by kind: exact from the scene built at l0 when that is at most
+    ``exact_up_to`` particles, else scaled from the scene built at a coarser spacing with
+    about ``scale_from`` particles (fluid by film layers and drop volume, walls by area)."""
+    rough = _rough_total(r)
+    if rough <= exact_up_to:
+        sc = r.build_scene()
+        c = sc.counts()
+        return {**c, "n_film": sc.info["n_film"], "n_drop": sc.info["n_drop"], "exact": True,
+                "built_l0": r.l0, "left_out": list(sc.info.get("left_out", [])),
+                "trimmed": sc.info.get("trimmed"), "walls": sc.info.get("walls"),
+                "extent_m": sc.info.get("extent_m")}
+    d, h, D = r.dim, r.scene["film"], r.scene["drop"]
+    l0c = r.l0 * (rough / scale_from) ** (1.0 / d)
+    l0c = min(l0c, min(h, D) / 3.0)
+    sc = r.build_scene(l0=l0c)
+    c = sc.counts()
+    k = l0c / r.l0
+    layers = math.floor(h / r.l0 + 1e-9) / max(math.floor(h / l0c + 1e-9), 1)
+    n_film = sc.info["n_film"] * k ** (d - 1) * layers
+    n_drop = (math.pi / 6 * D ** 3 if d == 3 else math.pi / 4 * D ** 2) / r.l0 ** d
+    fluid = int(round(n_film + n_drop))
+    area = k ** (d - 1)            # walls go with the floor area over l0^(d-1) ...
+    if sc.info.get("trimmed"):     # ... of a disc (a strip in 2D) with a rim of layers x l0
+        e, layers_w = sc.info["extent_m"], math.ceil(r.scene["re_ratio"] - 1e-9)
+        area *= ((e + layers_w * r.l0) / (e + layers_w * l0c)) ** (d - 1)
+    wall = int(round(c["wall"] * area))
+    dummy = int(round(c["dummy"] * area))
+    return {"fluid": fluid, "wall": wall, "dummy": dummy, "total": fluid + wall + dummy,
+            "n_film": int(round(n_film)), "n_drop": int(round(n_drop)), "exact": False,
+            "built_l0": l0c, "left_out": list(sc.info.get("left_out", [])),
+            "trimmed": sc.info.get("trimmed"), "walls": sc.info.get("walls"),
+            "extent_m": sc.info.get("extent_m")}
+
+
+def _rough_total(r: Resolved) -> float:
+    from ..scenes.crown import reach_radius
+    s, d, l0 = r.scene, r.dim, r.l0
+    half = s["floor"] / 2
+    reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"])
+    trimmed = s["trim"] and reach < half
+    e = reach if trimmed else half
+    area = (math.pi * e * e) if d == 3 else 2 * e          # floor area (length in 2D)
+    drop = math.pi / 6 * s["drop"] ** 3 if d == 3 else math.pi / 4 * s["drop"] ** 2
+    fluid = (area * s["film"] + drop) / l0 ** d
+    layers = math.ceil(s["re_ratio"])
+    walls = area / l0 ** (d - 1) * layers * (1.0 if trimmed else 1.5)
+    return fluid + walls
+
+
+def steps_to_end(r: Resolved) -> Dict:
+    """Steps to t_end. ``steps_at_U``: dt = the smallest limit at v = U all along (a floor);
+    ``steps``: that until the drop touches the film (gap / U), then dt at v = SPLASH_MACH c."""
+    lim = r.limits()
+    dt, binding = r.dt()
+    frames = len(r.frame_times())
+    contact = min(r.scene["gap"] / r.speed, r.t_end)
+    v_splash = max(r.speed, SPLASH_MACH * r.physics.c)
+    after = timestep.choose(r.physics, r.numerics, r.model, v_splash)
+    steps = math.ceil(contact / dt - 1e-9) + math.ceil((r.t_end - contact) / after[0] - 1e-9)
+    return {"dt_s": dt, "binding": binding, "limits_s": lim,
+            "steps_at_U": int(math.ceil(r.t_end / dt - 1e-9)) + frames,
+            "splash_speed_m_s": v_splash, "dt_after_contact_s": after[0],
+            "binding_after_contact": after[1], "steps": int(steps) + frames}
+
+
+def run_seconds(total: int, steps: int, tp: Throughput, cost: float = CROWN_COST) -> float:
+    """Compile + every particle (walls take part in the neighbour walks) x steps at the
+    bench's per-particle rate divided by the crown's cost factor. 2D steps are taken to cost
+    the 3D rate per particle (an upper figure: a 2D particle has fewer neighbours)."""
+    return tp.compile_s + total * steps * cost / tp.rate_total
+
+
+def memory_bytes(total: int, tp: Throughput) -> float:
+    return total * tp.bytes_per_particle
+
+
+def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Dict:
+    """Counts, steps, run time and memory of one preset at one quality."""
+    counts = particle_counts(r, exact_up_to)
+    st = steps_to_end(r)
+    secs = run_seconds(counts["total"], st["steps"], tp)
+    return {"particles": counts, **st, "run_seconds": secs,
+            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, 1.0),
+            "memory_bytes": memory_bytes(counts["total"], tp)}
+
+
+def human_seconds(s: float) -> str:
+    if s < 90:
+        return f"{s:.0f} s"
+    if s < 90 * 60:
+        return f"{s / 60:.1f} min"
+    if s < 48 * 3600:
+        return f"{s / 3600:.1f} h"
+    return f"{s / 86400:.1f} d"
+
+
+def human_count(n: float) -> str:
+    if n >= 1e6:
+        return f"{n / 1e6:.1f}M"
+    if n >= 1e4:
+        return f"{n / 1e3:.0f}k"
+    return f"{n:,.0f}"
+
+
+def human_bytes(b: float) -> str:
+    for unit, size in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if b >= size:
+            return f"{b / size:.3g} {unit}"
+    return f"{b:.0f} B"
+
+
+__all__ = ["Throughput", "throughput", "particle_counts", "steps_to_end", "run_seconds",
+           "memory_bytes", "summary", "human_seconds", "human_count", "human_bytes"]

@@ -1,0 +1,153 @@
+"""Finding and loading presets: a preset is ``presets/NAME.yaml`` (or any YAML file given by
+path); ``extends: OTHER`` loads OTHER first (a preset name, or a path relative to the file that
+extends it) and deep-merges this file onto it.
+
+The presets folder is ``presets/`` at the repository root, next to the ``crowndemo`` package;
+``$CROWNDEMO_PRESETS`` names another folder. Files whose name starts with ``_`` are not listed
+(bases meant only to be extended) but can still be named.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Dict, List, Optional
+
+from .errors import PresetError, did_you_mean
+from .merge import Origin, deep_merge, origin_of
+from .yamlio import load_text
+
+SUFFIXES = (".yaml", ".yml")
+MAX_DEPTH = 16
+
+
+def presets_dir() -> Path:
+    env = os.environ.get("CROWNDEMO_PRESETS")
+    if env:
+        return Path(env).expanduser()
+    import crowndemo
+    return Path(crowndemo.__file__).resolve().parent.parent / "presets"
+
+
+def preset_names(folder: Optional[Path] = None) -> List[str]:
+    folder = folder or presets_dir()
+    if not folder.is_dir():
+        return []
+    return sorted({p.stem for p in folder.iterdir()
+                   if p.suffix in SUFFIXES and p.is_file() and not p.stem.startswith("_")})
+
+
+def display(path: Path) -> str:
+    """How messages name a file: relative to the working directory when inside it."""
+    try:
+        rel = os.path.relpath(path)
+    except ValueError:
+        return str(path)
+    return str(path) if rel.startswith("..") else rel
+
+
+def looks_like_path(spec: str) -> bool:
+    return spec.endswith(SUFFIXES) or "/" in spec or os.sep in spec
+
+
+def find(spec: str, source: str = "command line", key: str = "preset",
+         relative_to: Optional[Path] = None) -> Path:
+    """The file of a preset name or path; a path is taken relative to ``relative_to``
+    (the folder of the file that names it) when given."""
+    if not isinstance(spec, str) or not spec.strip():
+        raise PresetError(source, key, spec, "not a preset name or path",
+                          "a preset name (crowndemo presets) or a path to a .yaml file")
+    folder = presets_dir()
+    if looks_like_path(spec):
+        path = Path(spec).expanduser()
+        if relative_to is not None and not path.is_absolute():
+            path = relative_to / path
+        if path.is_file():
+            return path.resolve()
+        raise PresetError(source, key, spec, f"no such file ({display(path)})",
+                          "an existing .yaml file, or a preset name")
+    for suffix in SUFFIXES:
+        path = folder / f"{spec}{suffix}"
+        if path.is_file():
+            return path.resolve()
+    if Path(spec).is_file():          # a file without the .yaml suffix, in the working folder
+        return Path(spec).resolve()
+    names = preset_names(folder)
+    raise PresetError(source, key, spec,
+                      f"no such preset in {display(folder)}{did_you_mean(spec, names)}",
+                      (", ".join(names) or "(none)") + ", or a path to a .yaml file")
+
+
+@dataclass
+class Document:
+    """A preset after ``extends`` and merging: the data, where each value came from, and the
+    order of the sources (a later source is more specific: parents < child < --set)."""
+    name: str
+    path: Path
+    label: str
+    data: dict
+    origin: Origin
+    chain: List[str] = field(default_factory=list)     # source labels, base first
+    ranks: Dict[str, int] = field(default_factory=dict)
+
+    def source_of(self, key_path) -> str:
+        """The source that wrote a key (or the nearest enclosing one), else this file."""
+        p = tuple(key_path)
+        while p:
+            if p in self.origin:
+                return self.origin[p]
+            p = p[:-1]
+        return self.label
+
+    def rank_of(self, key_path) -> int:
+        return self.ranks.get(self.origin.get(tuple(key_path), ""), -1)
+
+
+def load(spec: str, source: str = "command line") -> Document:
+    """Load a preset by name or path, with its ``extends`` chain merged."""
+    path = find(spec, source)
+    data, origin, chain = _load_chain(path, [])
+    name = path.stem
+    return Document(name, path, display(path), data, origin, chain,
+                    {label: i for i, label in enumerate(chain)})
+
+
+def _read(path: Path) -> dict:
+    label = display(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise PresetError(label, None, why=f"cannot read the file: "
+                          f"{getattr(e, 'strerror', None) or e}") from None
+    raw = load_text(text, label)
+    if not isinstance(raw, dict):
+        raise PresetError(label, None, why="not a preset: the top level must be a mapping "
+                          "(title:, scene:, quality:, ...)")
+    return raw
+
+
+def _load_chain(path: Path, stack: List[Path]):
+    label = display(path)
+    if path in stack:
+        cycle = " -> ".join(display(p) for p in stack + [path])
+        raise PresetError(display(stack[-1]), "extends", path.stem, f"extends cycle: {cycle}",
+                          "a chain of presets without cycles")
+    if len(stack) >= MAX_DEPTH:
+        raise PresetError(label, "extends", path.stem, f"more than {MAX_DEPTH} levels of extends",
+                          f"at most {MAX_DEPTH}")
+    raw = _read(path)
+    parent = raw.pop("extends", None)
+    if parent is not None:
+        if not isinstance(parent, str):
+            raise PresetError(label, "extends", parent, "not a preset name or path",
+                              "one preset name (crowndemo presets) or a path relative to "
+                              "this file")
+        base_path = find(parent, label, "extends", relative_to=path.parent)
+        base, base_origin, chain = _load_chain(base_path, stack + [path])
+    else:
+        base, base_origin, chain = {}, {}, []
+    data, origin = deep_merge(base, base_origin, raw, origin_of(raw, label))
+    return data, origin, chain + [label]
+
+
+__all__ = ["Document", "load", "find", "presets_dir", "preset_names", "display"]

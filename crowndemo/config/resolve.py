@@ -1,0 +1,231 @@
+"""From a validated preset and a quality to what runs: the keywords of
+``crowndemo.scenes.crown(...)``, the Numerics, and the checks that relate several values
+(speed or height, the drop against the container, l0 against the film and the drop, the time
+step the speed leaves). Nothing here starts Taichi."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional, Tuple
+
+from ..core import timestep
+from ..core.params import Model, Numerics, ParameterError, Physics
+from .errors import MISSING, PresetError
+from .loader import Document
+from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
+
+SPEED_MAX = 50.0        # m/s: beyond this the explicit step is not meant to serve
+DT_FLOOR = 1.0e-8       # s: a time step below this is refused (billions of steps)
+MIN_ACROSS = 3          # particles across the film and across the drop
+
+
+@dataclass
+class Resolved:
+    """One preset at one quality, ready to build: every value and where it came from."""
+    doc: Document
+    quality: str
+    values: dict                      # the validated document, defaults filled in
+    dim: int
+    l0: float
+    scene: dict                       # floor, film, drop, speed, height, gap, gravity, t_end, ...
+    liquid: dict                      # name, rho, nu, sigma
+    numerics: Numerics
+    physics: Physics
+    model: Model
+    where: Dict[str, Tuple[str, str]] = field(default_factory=dict)  # value -> (key, source)
+
+    @property
+    def name(self) -> str:
+        return self.doc.name
+
+    @property
+    def label(self) -> str:
+        return self.doc.label
+
+    @property
+    def title(self) -> dict:
+        return self.values["title"]
+
+    @property
+    def description(self) -> dict:
+        return self.values.get("description", {})
+
+    @property
+    def speed(self) -> float:
+        return self.scene["speed"]
+
+    @property
+    def t_end(self) -> float:
+        return self.scene["t_end"]
+
+    def crown_kwargs(self) -> dict:
+        """The keywords of ``crowndemo.scenes.crown`` (numerics included)."""
+        s = self.scene
+        return dict(dim=self.dim, l0=self.l0, film=s["film"], drop=s["drop"], speed=s["speed"],
+                    gap=s["gap"], floor=s["floor"], t_end=s["t_end"], trim=s["trim"],
+                    numerics=self.numerics, rho=self.liquid["rho"], nu=self.liquid["nu"],
+                    sigma=self.liquid["sigma"], gravity=s["gravity"],
+                    sound_speed=s.get("sound_speed"), re_ratio=s["re_ratio"])
+
+    def build_scene(self, l0: Optional[float] = None):
+        """The particles (numpy only); ``l0`` builds the same scene at another spacing."""
+        from ..scenes import crown
+        kw = self.crown_kwargs()
+        if l0 is not None:
+            kw["l0"] = l0
+        return crown(**kw)
+
+    def frame_times(self) -> List[float]:
+        """Frame times strictly inside (0, t_end], every frame_interval; [] without one."""
+        fi = self.scene.get("frame_interval")
+        if not fi:
+            return []
+        n = int(math.floor(self.t_end / fi + 1e-9))
+        return [k * fi for k in range(1, n + 1)]
+
+    def limits(self, speed: Optional[float] = None) -> Dict[str, float]:
+        return timestep.limits(self.physics, self.numerics, self.model,
+                               self.speed if speed is None else speed)
+
+    def dt(self) -> Tuple[float, str]:
+        return timestep.choose(self.physics, self.numerics, self.model, self.speed)
+
+
+def resolve(doc: Document, quality: str) -> Resolved:
+    """Validate the document and resolve it at ``quality``; PresetError on the first mistake."""
+    values = validate(doc)
+    where: Dict[str, Tuple[str, str]] = {}
+
+    def fail(name: str, value, why: str, allowed: str):
+        key, source = where[name]
+        raise PresetError(source, key, value, why, allowed)
+
+    def note(name: str, path) -> None:
+        where[name] = (dotted(path), doc.source_of(path) if tuple(path) in doc.origin
+                       else doc.label)
+
+    rungs = values["quality"]
+    if quality not in rungs:
+        defined = [q for q in QUALITIES if q in rungs]
+        why = ("this preset defines no quality rung" if not defined else
+               "this preset defines no such quality rung")
+        allowed = (", ".join(defined) if defined else
+                   "add quality: {draft: {l0: ...}} (rungs: " + ", ".join(QUALITIES) + ")")
+        raise PresetError(doc.label, f"quality.{quality}", MISSING, why, allowed)
+    rung = rungs[quality]
+    rpath = ("quality", quality)
+
+    # scene values, then the rung's where it is at least as specific as the scene's
+    scene = dict(values["scene"])
+    for k in scene:
+        note(k, ("scene", k))
+    for k in ("t_end", "frame_interval"):
+        if k in rung and doc.rank_of(rpath + (k,)) >= doc.rank_of(("scene", k)):
+            scene[k] = rung[k]
+            note(k, rpath + (k,))
+    num = dict(values.get("numerics", {}))
+    for k in num:
+        note("numerics." + k, ("numerics", k))
+    for k, v in rung.get("numerics", {}).items():
+        if doc.rank_of(rpath + ("numerics", k)) >= doc.rank_of(("numerics", k)):
+            num[k] = v
+            note("numerics." + k, rpath + ("numerics", k))
+    l0 = rung["l0"]
+    note("l0", rpath + ("l0",))
+    dim = values["dim"]
+
+    # speed or height
+    if "speed" in scene and "height" in scene:
+        fail("height", scene["height"], "give scene.speed or scene.height, not both",
+             f"one of them (scene.speed = {scene['speed']:g} m/s is also given)")
+    if "height" in scene:
+        H, g = scene["height"], scene["gravity"]
+        if g <= 0:
+            fail("height", H, "a fall height needs gravity (U = sqrt(2 g H)) but "
+                 "scene.gravity = 0", "scene.speed instead, or scene.gravity > 0")
+        U = math.sqrt(2.0 * g * H)
+        if U > SPEED_MAX:
+            fail("height", H, f"gives U = sqrt(2 g H) = {U:.4g} m/s, faster than the explicit "
+                 "step is meant to serve", f"<= {SPEED_MAX ** 2 / (2 * g):.4g} m "
+                 f"(U <= {SPEED_MAX:g} m/s)")
+        scene["speed"] = U
+        where["speed"] = where["height"]
+    elif "speed" not in scene:
+        raise PresetError(doc.label, "scene.speed", MISSING, "no impact speed: give "
+                          "scene.speed [m/s] or scene.height [m]", SCENE_KEYS["speed"].allowed())
+
+    # geometry
+    if scene["drop"] >= scene["floor"]:
+        fail("drop", scene["drop"], "the drop is wider than the container floor",
+             f"< scene.floor = {scene['floor']:g} m")
+    if scene.get("frame_interval") is not None and scene["frame_interval"] > scene["t_end"] * (
+            1 + 1e-9):
+        fail("frame_interval", scene["frame_interval"], "longer than the run",
+             f"<= t_end = {scene['t_end']:g} s")
+    for what, name, size in (("film", "film", scene["film"]), ("drop", "drop", scene["drop"])):
+        across = size / l0
+        if math.floor(across + 1e-9) < MIN_ACROSS:
+            sym = "h" if name == "film" else "D"
+            fail("l0", l0, f"too coarse: {across:.3g} particles across the {what} "
+                 f"({sym} = {size:g} m), at least {MIN_ACROSS} are needed",
+                 f"<= {sym}/{MIN_ACROSS} = {size / MIN_ACROSS:.4g} m")
+
+    # liquid
+    liq = dict(values["scene"]["liquid"])
+    name = liq.pop("name", "water")
+    liquid = {"name": name, **LIQUIDS[name], **liq}
+
+    # the core's own checks (the schema's ranges make these pass; kept as a safety net)
+    try:
+        numerics = Numerics(**num).validate()
+    except ParameterError as e:
+        fail("numerics." + e.key, e.value, "refused by the solver", e.allowed)
+    physics_keys = {"l0": "l0", "v_max": "speed", "re_ratio": "re_ratio",
+                    "sound_speed": "sound_speed", "gravity": "gravity"}
+    try:
+        physics = Physics(dim=dim, l0=l0, v_max=scene["speed"], re_ratio=scene["re_ratio"],
+                          rho=liquid["rho"], nu=liquid["nu"], sigma=liquid["sigma"],
+                          gravity=scene["gravity"],
+                          sound_speed=scene.get("sound_speed")).validate()
+    except ParameterError as e:
+        if e.key in physics_keys and physics_keys[e.key] in where:
+            fail(physics_keys[e.key], e.value, "refused by the solver", e.allowed)
+        raise PresetError(doc.label, f"scene.liquid.{e.key}", e.value, "refused by the solver",
+                          e.allowed) from None
+    model = Model.of(physics, numerics)
+
+    # the time step
+    lim = timestep.limits(physics, numerics, model, scene["speed"])
+    dt_name = min(lim, key=lim.get)
+    dt = lim[dt_name]
+    if dt < DT_FLOOR and numerics.fixed_dt is None:
+        why = (f"the time step would be {dt:.3g} s (bound by the {dt_name} limit), below "
+               f"{DT_FLOOR:g} s")
+        if dt_name == "courant":
+            fail("speed", scene.get("height", scene["speed"]), why,
+                 f"U <= {numerics.courant * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
+        elif dt_name == "acoustic" and scene.get("sound_speed") is not None:
+            fail("sound_speed", scene["sound_speed"], why,
+                 f"<= {numerics.acoustic * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
+        elif dt_name == "acoustic":
+            fail("speed", scene.get("height", scene["speed"]), why,
+                 f"U <= {numerics.acoustic * l0 / (5 * DT_FLOOR):.4g} m/s at l0 = {l0:g} m "
+                 "(c = 5 U)")
+        elif dt_name == "viscous":
+            fail("l0", l0, why, f">= {math.sqrt(DT_FLOOR * liquid['nu'] / numerics.viscous):.3g}"
+                 f" m at nu = {liquid['nu']:g} m^2/s")
+        elif dt_name == "capillary":
+            need = ((DT_FLOOR / numerics.capillary) ** 2 * 2 * math.pi * liquid["sigma"]
+                    / liquid["rho"]) ** (1 / 3)
+            fail("l0", l0, why, f">= {need:.3g} m at sigma = {liquid['sigma']:g} N/m")
+        else:
+            fail("numerics.dt_max", numerics.dt_max, why, f">= {DT_FLOOR:g} s")
+    try:
+        timestep.check_fixed_dt(physics, numerics, model)
+    except ParameterError as e:
+        fail("numerics.fixed_dt", e.value, "breaks a time-step limit", e.allowed)
+
+    return Resolved(doc, quality, values, dim, l0, scene, liquid, numerics, physics, model, where)
+
+
+__all__ = ["Resolved", "resolve", "SPEED_MAX", "DT_FLOOR", "MIN_ACROSS"]

@@ -1,0 +1,251 @@
+"""What a preset may contain: every key, its type, unit, allowed range and default.
+
+A preset (SI units throughout; lengths in m, times in s, speeds in m/s)::
+
+    title:       {en: ..., ja: ...}        # or one string (English)
+    description: {en: ..., ja: ...}
+    extends:     OTHER                     # optional; handled by the loader
+    dim:         3                         # 3, or 2 for a cross-section (a cylinder-drop slice)
+    scene:       {floor, film, drop, speed | height, gap, liquid, gravity, t_end,
+                  frame_interval, trim, re_ratio, sound_speed}
+    numerics:    {courant, acoustic, ...}  # overrides of crowndemo.core.params.Numerics
+    quality:     {draft: RUNG, booth: RUNG, seed: RUNG}
+    RUNG:        {l0, t_end, frame_interval, numerics}
+
+``validate`` checks one value at a time (unknown key, type, missing value, range) and returns
+the document with defaults filled in; checks that relate several values live in ``resolve``.
+"""
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass
+from typing import Any, Dict, Optional, Tuple
+
+from ..core.params import GRADIENT_FORMS
+from .errors import MISSING, PresetError, did_you_mean
+from .loader import Document
+
+QUALITIES = ("draft", "booth", "seed")
+LANGUAGES = ("en", "ja")
+
+# Named liquids. water: the seed's values (shared/docs/method.md §6). milk: typical whole milk
+# near 20 C (density 1030 kg/m^3, viscosity about 2 mPa s, surface tension about 0.045 N/m);
+# approximate, they vary with fat content and temperature.
+LIQUIDS: Dict[str, Dict[str, float]] = {
+    "water": {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728},
+    "milk": {"rho": 1030.0, "nu": 2.0e-6, "sigma": 0.045},
+}
+
+
+@dataclass(frozen=True)
+class Field:
+    kind: str                    # number | int | bool | choice | text | liquid | map
+    doc: str = ""
+    unit: str = ""
+    lo: Optional[float] = None
+    lo_incl: bool = False        # lo itself allowed?
+    hi: Optional[float] = None
+    hi_incl: bool = True
+    choices: Tuple = ()
+    required: bool = False
+    default: Any = None
+    keys: Optional[Dict[str, "Field"]] = None
+    allow_inf: bool = False
+
+    def allowed(self) -> str:
+        if self.kind in ("number", "int"):
+            parts = []
+            if self.lo is not None:
+                parts.append(f"{'>=' if self.lo_incl else '>'} {self.lo:g}")
+            if self.hi is not None:
+                parts.append(f"{'<=' if self.hi_incl else '<'} {self.hi:g}")
+            text = " and ".join(parts) or "any finite number"
+            if self.kind == "int":
+                text = f"an integer {text}"
+            if self.unit:
+                text += f" {self.unit}"
+            if self.allow_inf:
+                text += " (.inf: no limit)"
+            return text
+        if self.kind == "bool":
+            return "true or false"
+        if self.kind == "choice":
+            return " or ".join(str(c) for c in self.choices)
+        if self.kind == "text":
+            return "a string, or {en: ..., ja: ...}"
+        if self.kind == "liquid":
+            return (f"a liquid name ({', '.join(LIQUIDS)}) or a mapping "
+                    "{name:, rho:, nu:, sigma:}")
+        return "a mapping with keys " + ", ".join(self.keys or ())
+
+
+def number(doc, unit="", lo=None, hi=None, lo_incl=False, hi_incl=True, **kw) -> Field:
+    return Field("number", doc, unit, lo, lo_incl, hi, hi_incl, **kw)
+
+
+TEXT = Field("text", "a text in English (en) and Japanese (ja)")
+
+LIQUID_KEYS = {
+    "name": Field("choice", "a named liquid whose values the other keys override",
+                  choices=tuple(LIQUIDS), default="water"),
+    "rho": number("density", "kg/m^3", 0, 25000),
+    "nu": number("kinematic viscosity (0: no viscosity term)", "m^2/s", 0, 0.1, lo_incl=True),
+    "sigma": number("surface tension (0: no surface-tension term)", "N/m", 0, 1, lo_incl=True),
+}
+
+SCENE_KEYS = {
+    "floor": number("side of the square container floor (width of the 2D slice)", "m", 0, 1,
+                    default=0.09),
+    "film": number("film thickness h", "m", 0, 0.1, required=True),
+    "drop": number("drop diameter D", "m", 0, 0.1, required=True),
+    "speed": number("impact speed U of the drop (or give height)", "m/s", 0, 50),
+    "height": number("fall height H (instead of speed): U = sqrt(2 g H), no air drag", "m",
+                     0, 1000),
+    "gap": number("from the film surface up to the bottom of the drop", "m", 0, 0.1,
+                  lo_incl=True, default=1.0e-3),
+    "liquid": Field("liquid", "the liquid of the drop and the film", default="water"),
+    "gravity": number("gravitational acceleration, along -z", "m/s^2", 0, 100, lo_incl=True,
+                      default=9.81),
+    "t_end": number("simulated time", "s", 0, 10, required=True),
+    "frame_interval": number("time between recorded frames", "s", 0, 10),
+    "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
+                  default=True),
+    "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
+    "sound_speed": number("artificial sound speed c (default 5 U, S8)", "m/s", 0, 1.0e5),
+}
+
+_C = dict(lo=0, hi=2)
+NUMERICS_KEYS = {
+    "courant": number("velocity Courant number v dt / l0 (S5)", "", **_C),
+    "acoustic": number("acoustic Courant number c dt / l0 (S6)", "", **_C),
+    "viscous": number("viscous number nu dt / l0^2 (M1)", "", **_C),
+    "capillary": number("fraction of the capillary limit (M1)", "", **_C),
+    "dt_max": number("largest time step", "s", 0, None, allow_inf=True),
+    "fixed_dt": number("a fixed time step instead of the adaptive one", "s", 1.0e-8, 1.0,
+                       lo_incl=True),
+    "pressure_gradient": Field("choice", "pressure-gradient form (M2)", choices=GRADIENT_FORMS),
+    "beta": number("free-surface threshold n < beta n0 (M3)", "", 0.5, 1.0, lo_incl=True,
+                   hi_incl=False),
+    "max_density_excess": number("abort when n/n0 - 1 exceeds this", "", 0, 10),
+    "max_mach": number("abort when a speed exceeds this times c", "", 0, 10),
+    "max_out_fraction": number("abort when more fluid than this has left the domain", "",
+                               0, 1, lo_incl=True),
+    "reorder_every": Field("int", "re-sort particles into cell order every N steps (0: never)",
+                           lo=0, lo_incl=True, hi=1_000_000),
+}
+
+RUNG_KEYS = {
+    "l0": number("particle spacing", "m", 0, 0.01, required=True),
+    "t_end": number("simulated time at this quality (replaces scene.t_end)", "s", 0, 10),
+    "frame_interval": number("time between frames at this quality", "s", 0, 10),
+    "numerics": Field("map", "numerics at this quality", keys=NUMERICS_KEYS),
+}
+RUNG = Field("map", "one quality rung", keys=RUNG_KEYS)
+
+TOP_KEYS = {
+    "title": Field("text", "a short title", required=True),
+    "description": Field("text", "what the preset shows"),
+    "dim": Field("choice", "3, or 2 for a cross-section", choices=(3, 2), default=3),
+    "scene": Field("map", "the drop-on-film scene", required=True, keys=SCENE_KEYS),
+    "numerics": Field("map", "overrides of crowndemo.core.params.Numerics", keys=NUMERICS_KEYS),
+    "quality": Field("map", "the quality ladder", required=True,
+                     keys={q: RUNG for q in QUALITIES}),
+}
+TOP = Field("map", "a preset", keys=TOP_KEYS)
+
+
+def dotted(path) -> str:
+    return ".".join(str(p) for p in path)
+
+
+def validate(doc: Document) -> dict:
+    """The preset's values with defaults filled in; PresetError on the first bad value."""
+    return _check(TOP, doc.data, (), doc)
+
+
+def _fail(doc: Document, path, value, why: str, allowed: str):
+    raise PresetError(doc.source_of(path), dotted(path), value, why, allowed)
+
+
+def _check(f: Field, v, path, doc: Document):
+    if f.kind == "map":
+        if not isinstance(v, dict):
+            _fail(doc, path, v, "not a mapping (key: value lines)", f.allowed())
+        return _check_map(f.keys, v, path, doc)
+    if f.kind == "number":
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            _fail(doc, path, v, "not a number", f.allowed())
+        v = float(v)
+        if math.isnan(v) or (math.isinf(v) and not f.allow_inf):
+            _fail(doc, path, v, "not a finite number", f.allowed())
+        _range(f, v, path, doc)
+        return v
+    if f.kind == "int":
+        if isinstance(v, bool) or not isinstance(v, int):
+            _fail(doc, path, v, "not an integer", f.allowed())
+        _range(f, v, path, doc)
+        return v
+    if f.kind == "bool":
+        if not isinstance(v, bool):
+            _fail(doc, path, v, "not true or false", f.allowed())
+        return v
+    if f.kind == "choice":
+        if not any(type(v) is type(c) and v == c for c in f.choices):
+            why = "not one of the choices" + did_you_mean(v, [str(c) for c in f.choices])
+            _fail(doc, path, v, why, f.allowed())
+        return v
+    if f.kind == "text":
+        if isinstance(v, str):
+            return {"en": v}
+        if not isinstance(v, dict):
+            _fail(doc, path, v, "not a text", f.allowed())
+        for k, t in v.items():
+            if k not in LANGUAGES:
+                _fail(doc, path + (k,), t, "unknown language" + did_you_mean(k, LANGUAGES),
+                      ", ".join(LANGUAGES))
+            if not isinstance(t, str):
+                _fail(doc, path + (k,), t, "not a string", "a text")
+        if "en" not in v:
+            raise PresetError(doc.source_of(path), dotted(path + ("en",)), MISSING,
+                              "no English text", "a string")
+        return dict(v)
+    if f.kind == "liquid":
+        if isinstance(v, str):
+            if v not in LIQUIDS:
+                _fail(doc, path, v, "unknown liquid" + did_you_mean(v, LIQUIDS), f.allowed())
+            v = {"name": v}
+        elif not isinstance(v, dict):
+            _fail(doc, path, v, "not a liquid", f.allowed())
+        out = _check_map(LIQUID_KEYS, v, path, doc)
+        return out
+    raise AssertionError(f.kind)
+
+
+def _range(f: Field, v, path, doc: Document) -> None:
+    low = f.lo is not None and (v < f.lo or (v == f.lo and not f.lo_incl))
+    high = f.hi is not None and (v > f.hi or (v == f.hi and not f.hi_incl))
+    if low or high:
+        _fail(doc, path, v, "out of range", f.allowed())
+
+
+def _check_map(keys: Dict[str, Field], v: dict, path, doc: Document) -> dict:
+    for k, item in v.items():
+        if k not in keys:
+            _fail(doc, path + (k,), item, "unknown key" + did_you_mean(k, [str(x) for x in keys]),
+                  ", ".join(str(x) for x in keys))
+    out = {}
+    for k, f in keys.items():
+        p = path + (k,)
+        if k in v:
+            out[k] = _check(f, v[k], p, doc)
+        elif f.required:
+            raise PresetError(doc.label, dotted(p), MISSING, "no value given"
+                              + (f" ({f.doc})" if f.doc else ""), f.allowed())
+        elif f.default is not None:
+            out[k] = _check(f, copy.deepcopy(f.default), p, doc)
+    return out
+
+
+__all__ = ["validate", "Field", "QUALITIES", "LIQUIDS", "TOP_KEYS", "SCENE_KEYS",
+           "NUMERICS_KEYS", "RUNG_KEYS", "LIQUID_KEYS", "dotted"]
