@@ -27,6 +27,14 @@ def laplacian_pair(dphi, w):
     return dphi * w
 
 
+def make_density_task(coef: Coefficients):
+    """The neighbour task of the number density (S9): acc += w(r_ij), every kind counted."""
+    @ti.func
+    def task(i, j, rij, r2, acc: ti.template()):
+        acc += weight(ti.sqrt(r2), coef.re[None])
+    return task
+
+
 @ti.data_oriented
 class Operators:
     """Stand-alone operators over all live particles (used by tests, diagnostics and n0 checks).
@@ -37,10 +45,7 @@ class Operators:
     def __init__(self, grid: CellGrid, coef: Coefficients):
         self.grid, self.coef, self.state = grid, coef, grid.state
         self.dim = grid.dim
-
-    @ti.func
-    def _density_task(self, i, j, rij, r2, acc: ti.template()):
-        acc += weight(ti.sqrt(r2), self.coef.re[None])
+        self._density_task = make_density_task(coef)
 
     @ti.kernel
     def number_density(self, out: ti.template()):

@@ -10,7 +10,7 @@ import taichi as ti
 
 from .coefficients import Coefficients
 from .grid import CellGrid
-from .operators import gradient_pair, weight
+from .operators import gradient_pair, make_density_task, weight
 from .params import Model
 from .state import DUMMY, FLUID, WALL
 
@@ -35,10 +35,7 @@ class Pressure:
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
         self.dim = model.dim
         self.sums = _gradient_sums(self.dim)
-
-    @ti.func
-    def _density_pair(self, i, j, rij, r2, acc: ti.template()):
-        acc += weight(ti.sqrt(r2), self.coef.re[None])
+        self._density_pair = make_density_task(coef)
 
     @ti.kernel
     def density_and_pressure(self):

@@ -67,13 +67,10 @@ class Simulator:
         self.predictor = Predictor(self.model, self.grid, self.coef)
         self.pressure = Pressure(self.model, self.grid, self.coef)
         self.health = Health(self.state, self.coef)
-        self.physics, self.numerics = physics, numerics
-        self.lattice = LatticeConstants.compute(dim, physics.l0, physics.re_ratio, physics.rho,
-                                                physics.sigma)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0
-        self.configure(physics, numerics)
+        self.configure(physics, numerics)      # sets physics, numerics and lattice
 
     # ---- set-up --------------------------------------------------------------------------
     def configure(self, physics: Physics, numerics: Numerics,

@@ -3,5 +3,5 @@ from .base import Scene, container_walls, lattice_block, wall_layers
 from .crown import crown, crown_base_radius
 from .reference import circularity, dam_break, equivalent_radius, hydrostatic_tank, square_patch
 
-__all__ = ["crown", "crown_base_radius", "Scene", "container_walls", "lattice_block", "wall_layers", "circularity", "dam_break",
-           "equivalent_radius", "hydrostatic_tank", "square_patch"]
+__all__ = ["Scene", "circularity", "container_walls", "crown", "crown_base_radius", "dam_break",
+           "equivalent_radius", "hydrostatic_tank", "lattice_block", "square_patch", "wall_layers"]
