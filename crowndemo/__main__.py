@@ -1,3 +1,6 @@
+"""``python -m crowndemo``: the command line."""
+import sys
+
 from .cli import main
 
-raise SystemExit(main())
+sys.exit(main())

@@ -1,0 +1,185 @@
+"""What every ``crowndemo`` command shares: the error types and formatter, the backend options,
+preset loading, running a simulator with a progress line, and the run summary.
+
+User mistakes (bad flags, parameters out of range, an unavailable arch) print one line
+``crowndemo: error: ...`` on stderr and return 2; an unstable run prints the reason and returns 3.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+import time
+from typing import Callable, Dict, Optional, Sequence
+
+from ..backend import ARCHS, PRECISIONS
+from ..core.params import Numerics, ParameterError
+
+PROG = "crowndemo"
+PROGRESS_EVERY_S = 2.0
+NUMERICS = Numerics()       # the core's defaults, shown in --help
+
+# command-line option for each parameter name that a ParameterError can carry
+OPTION_OF = {"dim": "--dim", "l0": "--l0", "v_max": "--speed", "re_ratio": "--re-ratio",
+             "rho": "--rho", "nu": "--nu", "sigma": "--sigma", "sound_speed": "--sound-speed",
+             "pressure_gradient": "--gradient", "t_end": "--t-end", "width": "--width",
+             "depth": "--depth", "a": "--a", "side": "--side", "n": "--n", "steps": "--steps",
+             "courant": "--courant", "acoustic": "--acoustic", "max_steps": "--max-steps"}
+
+
+class UsageError(Exception):
+    """A command-line mistake found by argparse."""
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message):          # one line, no usage dump, no SystemExit
+        raise UsageError(f"{message} (see '{self.prog} --help')")
+
+
+class Fmt(argparse.RawDescriptionHelpFormatter):
+    def __init__(self, prog):
+        super().__init__(prog, max_help_position=32)
+
+
+def backend_options() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(add_help=False)
+    g = p.add_argument_group("backend options")
+    g.add_argument("--arch", choices=ARCHS, default=None,
+                   help="Taichi backend; auto tries a GPU and falls back to the CPU "
+                        "(default: $CROWNDEMO_ARCH, else cpu)")
+    g.add_argument("--precision", choices=PRECISIONS, default="f32",
+                   help="float precision of every field and kernel (default: f32)")
+    g.add_argument("--seed", type=int, default=0, help="Taichi random seed (default: 0)")
+    g.add_argument("--single-thread", action="store_true",
+                   help="one CPU thread: bit-identical results from run to run")
+    return p
+
+
+def start_backend(args):
+    import contextlib
+
+    from .. import backend
+    # ti.init prints "[Taichi] Starting on arch=..." on stdout: send it to stderr
+    with contextlib.redirect_stdout(sys.stderr):
+        return backend.init(args.arch, args.precision, args.seed, args.single_thread)
+
+
+def fmt_counts(counts: Dict[str, int]) -> str:
+    parts = [f"{counts[k]:,} {k}" for k in ("fluid", "wall", "dummy", "gone") if counts.get(k)]
+    return ", ".join(parts) + f" ({sum(counts.values()):,} total)"
+
+
+class StopRun(Exception):
+    """Raised from the step callback to end a run early (--max-steps)."""
+
+
+def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
+             max_steps: Optional[int] = None,
+             on_frame: Optional[Callable[[object, int], None]] = None) -> Dict:
+    """Run ``sim`` to ``t_end`` (or ``max_steps``) with a progress line on stderr every ~2 s
+    (simulated time, steps/s, ETA); returns the stats, the peak health figures and whether
+    the run stopped early."""
+    h0 = sim.stats.health
+    peak = {"speed": h0.max_speed, "excess": h0.max_density_excess}
+    prog = {"t": time.perf_counter(), "steps": 0, "sim_t": 0.0}
+
+    def on_step(s):
+        h = s.stats.health
+        peak["speed"] = max(peak["speed"], h.max_speed)
+        peak["excess"] = max(peak["excess"], h.max_density_excess)
+        now = time.perf_counter()
+        if s.stats.steps == 1:          # the first step compiles the kernels: not in the rate
+            if not quiet:
+                print(f"  first step (compiling) {now - prog['t']:.1f} s", file=sys.stderr,
+                      flush=True)
+            prog["t"], prog["steps"], prog["sim_t"] = now, 1, s.stats.time
+        elif not quiet and now - prog["t"] >= PROGRESS_EVERY_S:
+            rate = (s.stats.steps - prog["steps"]) / (now - prog["t"])
+            sim_rate = (s.stats.time - prog["sim_t"]) / (now - prog["t"])
+            left = (t_end - s.stats.time) / sim_rate if sim_rate > 0 else math.inf
+            if max_steps is not None and rate > 0:
+                left = min(left, (max_steps - s.stats.steps) / rate)
+            print(f"  t = {s.stats.time * 1e3:8.3f} / {t_end * 1e3:g} ms  step {s.stats.steps:6d}"
+                  f"  {rate:7.1f} steps/s  ETA {clock(left)}  max speed {h.max_speed:.3g} m/s",
+                  file=sys.stderr, flush=True)
+            prog["t"], prog["steps"], prog["sim_t"] = now, s.stats.steps, s.stats.time
+        if max_steps is not None and s.stats.steps >= max_steps:
+            raise StopRun
+
+    stopped = False
+    try:
+        stats = sim.run(t_end, frame_times=frame_times, on_frame=on_frame, on_step=on_step)
+    except StopRun:
+        stats, stopped = sim.stats, True
+    return {"stats": stats, "peak": peak, "stopped_early": stopped}
+
+
+def clock(seconds: float) -> str:
+    if not math.isfinite(seconds):
+        return "--:--"
+    s = int(round(seconds))
+    if s >= 3600:
+        return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}"
+    return f"{s // 60}:{s % 60:02d}"
+
+
+def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:
+    """The JSON part shared by `scene` and `run`: stats, health with peaks, particles."""
+    d = run["stats"].as_dict()
+    d["health"]["peak_max_speed_m_s"] = run["peak"]["speed"]
+    d["health"]["peak_max_density_excess"] = run["peak"]["excess"]
+    return {"particles": counts, "setup_seconds": setup_s, **d}
+
+
+def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: float,
+                   setup_s: float, obs: Optional[Dict] = None) -> None:
+    """The summary of a run on stdout: particles, steps and dt with the limits that bound it,
+    health, an observable when there is one, wall time."""
+    stats, peak = run["stats"], run["peak"]
+    h = stats.health
+    e0, e1 = stats.energy_start, h.energy
+    de = f" ({(e1 - e0) / abs(e0) * 100:+.2f} %)" if e0 else ""
+    binding = ", ".join(f"{k} {v}" for k, v in stats.binding.most_common())
+    left = ", ".join(f"{v} {k}" for k, v in h.left.items()) or "none"
+    print(head)
+    print(f"  particles   {fmt_counts(counts)}")
+    early = " (stopped early: --max-steps)" if run.get("stopped_early") else ""
+    print(f"  simulated   {stats.time * 1e3:.4g} ms in {stats.steps:,} steps{early}; dt "
+          f"{stats.dt_min:.3g} .. {stats.dt_max:.3g} s; steps bound by: {binding}")
+    print(f"  health      max speed {h.max_speed:.4g} m/s (peak {peak['speed']:.4g}, "
+          f"c = {sound_speed:.4g}); max density excess n/n0 - 1 = "
+          f"{h.max_density_excess:.4g} (peak {peak['excess']:.4g})")
+    print(f"              energy {e0:.6g} J -> {e1:.6g} J{de}; left the domain: {left}")
+    if obs:
+        print(f"  result      {obs['text']}")
+    rate = stats.steps / stats.wall_seconds if stats.wall_seconds > 0 else math.nan
+    print(f"  wall time   {setup_s + stats.wall_seconds:.2f} s (set-up {setup_s:.2f} s, "
+          f"stepping {stats.wall_seconds:.2f} s incl. compiling, {rate:.1f} steps/s)")
+
+
+PRESET_HELP = "a preset name (see 'crowndemo presets') or a path to a preset YAML file"
+SET_HELP = ("override a preset value, KEY.PATH=VALUE with VALUE read as YAML, e.g. "
+            "scene.speed=7, quality.draft.l0=4e-4, numerics.courant=0.1; repeatable; "
+            "an empty VALUE restores the default")
+
+
+def load_preset(spec: str, args, quality: Optional[str] = None):
+    from .. import config
+    return config.load(spec, quality or args.quality or config.DEFAULT_QUALITY, args.sets)
+
+
+def repo_root() -> str:
+    return os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def error(message: str) -> int:
+    print(f"{PROG}: error: {message}", file=sys.stderr)
+    return 2
+
+
+def parameter_message(e: ParameterError) -> str:
+    opt = OPTION_OF.get(e.key)
+    where = f" (option {opt})" if opt else ""
+    return f"{e.key} = {e.value!r} is out of range; allowed: {e.allowed}{where}"
+

@@ -1,0 +1,120 @@
+"""``crowndemo presets``: the presets with their titles, particle counts and run-time
+estimates per quality."""
+from __future__ import annotations
+
+import json
+import os
+
+from ..config import PresetError
+from .common import (Fmt, error)
+
+
+PRESETS_EPILOG = """\
+examples:
+  crowndemo presets                 # name, title, particles and run time per quality
+  crowndemo presets --lang ja       # titles in Japanese
+  crowndemo presets --rate 5e7      # estimate for a machine that does 5e7 particle-steps/s
+  crowndemo presets --json
+
+The presets are the YAML files in presets/ at the repository root ($CROWNDEMO_PRESETS names
+another folder). Particle counts come from building each scene with numpy (no kernel runs);
+counts marked ~ are scaled from a build at a coarser spacing. The run time is rough: compile
++ (every particle) x steps / rate, with steps = t_end / dt at the drop's speed and the rate
+from the newest CPU section of BENCHMARKS.md; a splash faster than the drop takes smaller
+steps, so real runs take longer.
+"""
+
+
+def _display_width(text: str) -> int:
+    import unicodedata
+    return sum(2 if unicodedata.east_asian_width(ch) in "WF" else 1 for ch in text)
+
+
+def _pad(text: str, width: int) -> str:
+    return text + " " * max(width - _display_width(text), 0)
+
+
+def _presets(args) -> int:
+    import textwrap
+
+    from .. import config
+    from ..config import estimate, schema
+
+    tp = estimate.throughput(rate=args.rate)
+    folder = config.presets_dir()
+    rows, errors = [], []
+    for name in config.preset_names(folder):
+        try:
+            doc = config.load_document(name)
+            values = schema.validate(doc)
+            row = {"name": name, "file": doc.label, "dim": values["dim"],
+                   "title": values["title"], "description": values.get("description", {}),
+                   "extends": doc.chain[-2] if len(doc.chain) > 1 else None, "qualities": {}}
+            for q in config.QUALITIES:
+                if q not in values["quality"]:
+                    continue
+                r = config.resolve(doc, q)
+                e = estimate.summary(r, tp)
+                part = e["particles"]
+                row["qualities"][q] = {
+                    "l0_m": r.l0, "t_end_s": r.t_end, "speed_m_s": r.speed,
+                    "particles": {k: part[k] for k in ("fluid", "wall", "dummy", "total")},
+                    "exact_count": part["exact"], "steps": e["steps"], "dt_s": e["dt_s"],
+                    "binding": e["binding"], "run_seconds_estimate": e["run_seconds"],
+                    "memory_bytes": e["memory_bytes"]}
+            rows.append(row)
+        except PresetError as e:
+            errors.append(e)
+    if args.json:
+        print(json.dumps({"folder": str(folder), "throughput": {
+            "fluid_particle_steps_per_s": tp.rate, "all_particle_steps_per_s": tp.rate_total,
+            "compile_s": tp.compile_s, "source": tp.source}, "presets": rows}, indent=2))
+    else:
+        lang = args.lang
+        titles = [row["title"].get(lang) or row["title"]["en"] for row in rows]
+        tw = min(max([_display_width(t) for t in titles] + [5]), 60)
+        nw = max([len(row["name"]) for row in rows] + [4])
+        head = f"{'NAME':<{nw}}  DIM  {_pad('TITLE', tw)}"
+        for q in config.QUALITIES:
+            head += f"  {q.upper():<15}"
+        print(f"presets in {config.display(folder)}{os.sep}: fluid particles and a rough run "
+              "time per quality on this machine")
+        print(head.rstrip())
+        for row, title in zip(rows, titles):
+            line = f"{row['name']:<{nw}}  {row['dim']}D   {_pad(title, tw)}"
+            for q in config.QUALITIES:
+                e = row["qualities"].get(q)
+                if e is None:
+                    cell = "-"
+                else:
+                    approx = "" if e["exact_count"] else "~"
+                    count = approx + estimate.human_count(e["particles"]["fluid"])
+                    cell = f"{count:>6} {estimate.human_seconds(e['run_seconds_estimate']):>8}"
+                line += f"  {cell:<15}"
+            print(line.rstrip())
+        for line in textwrap.wrap(
+                f"~: particle count scaled from a coarser build. Run time: compile + every "
+                f"particle x steps x {estimate.CROWN_COST:g} (a crown step's cost) / "
+                f"{tp.rate_total:.3g} particle-steps/s ({tp.rate:.3g} fluid; {tp.source}); "
+                f"steps: dt at the drop's speed until contact, then at the splash's "
+                f"{estimate.SPLASH_MACH:g} c (measured). Details: crowndemo info PRESET "
+                f"--quality Q.", 96):
+            print(line)
+    for e in errors:
+        error(str(e))
+    return 2 if errors else 0
+
+
+def register(sub, common) -> None:
+    p = sub.add_parser("presets", formatter_class=Fmt, epilog=PRESETS_EPILOG,
+                       help="list the presets: title, particles and run time per quality",
+                       description="List the presets with their title, fluid particle count "
+                                   "and a rough run time per quality (draft, booth, seed); no "
+                                   "kernel runs.")
+    p.add_argument("--lang", choices=("en", "ja"), default="en",
+                   help="language of the titles (default: en)")
+    p.add_argument("--rate", type=float, metavar="R",
+                   help="fluid particle-steps per second to estimate with (default: the "
+                        "newest CPU figure in BENCHMARKS.md)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(func=lambda a, argv: _presets(a))

@@ -1,0 +1,195 @@
+"""``crowndemo scene``: the reference scenes (tank, dam break, patch) with the one figure
+each is checked against (method.md §7)."""
+from __future__ import annotations
+
+import json
+import math
+import sys
+import time
+from typing import Dict
+
+from ..core.params import GRADIENT_FORMS, Numerics, ParameterError
+from .common import (NUMERICS, PROG, Fmt, print_summary, run_result, simulate, start_backend)
+
+
+# per scene, by dimension: the defaults of its options (keys are the builders' keywords)
+SCENES = {
+    "tank": {"defaults": {2: dict(l0=1e-3, width=0.04, depth=0.04, nu=1e-3, t_end=0.2),
+                          3: dict(l0=2e-3, width=0.04, depth=0.04, nu=1e-3, t_end=0.2)}},
+    "dam-break": {"defaults": {2: dict(l0=1e-3, a=0.05, t_end=0.1),
+                               3: dict(l0=2e-3, a=0.03, t_end=0.1)}},
+    "patch": {"defaults": {2: dict(l0=1e-4, side=2e-3, sigma=0.0728, t_end=0.03),
+                           3: dict(l0=2e-4, side=2e-3, sigma=0.0728, t_end=0.03)}},
+}
+
+SCENE_HELP = {
+    "tank": "water at rest in an open container; pressure tends to rho g (H - z)",
+    "dam-break": "a water column a wide, 2a high collapses along a channel 4a long "
+                 "(Martin & Moyce)",
+    "patch": "a square (cube) of liquid without gravity, rounded up by surface tension",
+}
+
+SCENE_EPILOG = """\
+examples:
+  crowndemo scene dam-break --dim 3 --t-end 0.05      # what `make demo` runs
+  crowndemo scene dam-break --dim 2 --l0 5e-4 --gradient sum
+  crowndemo scene tank --dim 2 --depth 0.08 --t-end 0.3
+  crowndemo scene patch --dim 3 --side 3e-3 --sigma 0.05 --json
+
+defaults by dimension (2D / 3D):
+  tank       l0 1 / 2 mm, width = depth = 40 mm, nu 1e-3 m^2/s (settles the start-up waves), t-end 0.2 s
+  dam-break  l0 1 / 2 mm, a 50 / 30 mm, t-end 0.1 s
+  patch      l0 0.1 / 0.2 mm, side 2 mm, sigma 0.0728 N/m, t-end 0.03 s
+A progress line (simulated time, steps/s) goes to stderr every ~2 s; the summary to stdout.
+An unstable run stops with exit status 3 and says what broke; lower the safety numbers
+(e.g. --acoustic 0.5 --courant 0.1, half the seed's time step) or try another --gradient.
+"""
+
+
+def _positive(key: str, value: float, unit: str) -> None:
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise ParameterError(key, value, f"> 0 {unit}".rstrip(), "command line")
+
+
+def _build_scene(name: str, args):
+    from .. import scenes
+
+    d = SCENES[name]["defaults"][args.dim]
+    val = {k: (getattr(args, k) if getattr(args, k, None) is not None else v)
+           for k, v in d.items()}
+    _positive("l0", val["l0"], "m")
+    _positive("t_end", val["t_end"], "s")
+    for k in ("width", "depth", "a", "side"):
+        if k in val:
+            _positive(k, val[k], "m")
+            if val[k] < val["l0"]:
+                raise ParameterError(k, val[k], f">= l0 = {val['l0']:g} m", "command line")
+    numerics = Numerics(pressure_gradient=args.gradient, courant=args.courant,
+                        acoustic=args.acoustic)
+    common = dict(dim=args.dim, l0=val["l0"], t_end=val["t_end"], numerics=numerics)
+    if name == "tank":
+        sc = scenes.hydrostatic_tank(width=val["width"], depth=val["depth"], nu=val["nu"],
+                                     **common)
+    elif name == "dam-break":
+        sc = scenes.dam_break(a=val["a"], **common)
+    else:
+        sc = scenes.square_patch(side=val["side"], sigma=val["sigma"], **common)
+    sc.physics.validate("command line")
+    sc.numerics.validate("command line")
+    return sc, val
+
+
+# Martin & Moyce (1952), column a x 2a: (T = t sqrt(2 g / a), Z = z / a), method.md §7
+MARTIN_MOYCE = ((0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.345, 4.134),
+                (4.034, 4.944), (4.418, 5.881), (5.091, 6.980), (5.685, 7.945), (6.306, 8.966),
+                (6.822, 9.986))
+
+
+def _observables(name: str, scene, sim) -> Dict:
+    """One scene-specific figure against its reference (method.md §7), at the end time."""
+    import numpy as np
+
+    from ..core.state import FLUID
+    from ..scenes import circularity, equivalent_radius
+
+    sim.refresh_pressure()
+    snap = sim.snapshot()
+    fluid = snap["kind"] == FLUID
+    pos = snap["pos"][fluid].astype(float)
+    p = snap["pressure"][fluid].astype(float)
+    ph = scene.physics
+    if len(pos) == 0:
+        return {}
+    if name == "tank":
+        depth = scene.info["depth_m"]
+        z = pos[:, -1]
+        lower = z < 0.5 * depth
+        ref = ph.rho * ph.gravity * (depth - z[lower])
+        ratio = float(p[lower].sum() / ref.sum()) if ref.sum() > 0 else math.nan
+        return {"pressure_over_hydrostatic_lower_half": ratio,
+                "text": f"pressure / rho g (H - z), fluid in the lower half: {ratio:.3f} "
+                        "(hydrostatics: 1)"}
+    if name == "dam-break":
+        a = scene.info["a_m"]
+        T = sim.stats.time * math.sqrt(2.0 * ph.gravity / a)
+        Z = float(pos[:, 0].max() + 0.5 * ph.l0) / a
+        Ts, Zs = zip(*MARTIN_MOYCE)
+        ref = float(np.interp(T, Ts, Zs)) if Ts[0] <= T <= Ts[-1] else None
+        text = f"surge front Z = z/a = {Z:.3f} at T = t sqrt(2g/a) = {T:.3f}"
+        text += (f"; Martin & Moyce: {ref:.3f}" if ref is not None else
+                 f"; Martin & Moyce tabulate T = {Ts[0]} .. {Ts[-1]}")
+        if Z >= scene.info["length_a"] - 0.1:
+            text += " (front at the end wall)"
+        return {"T": T, "front_Z": Z, "martin_moyce_Z": ref, "text": text}
+    # patch
+    R = equivalent_radius(len(pos), ph.dim, ph.l0)
+    circ = circularity(pos, ph.l0)
+    return {"circularity": circ, "equivalent_radius_m": R,
+            "text": f"circularity R_eq/R_out = {circ:.3f} (square 0.80, disc 1.00), "
+                    f"R_eq = {R * 1e3:.4g} mm"}
+
+
+def _scene(args) -> int:
+    from ..core import simulator_for
+
+    name = args.scene
+    be = start_backend(args)
+    t0 = time.perf_counter()
+    scene, val = _build_scene(name, args)
+    sim = simulator_for(scene)
+    setup_s = time.perf_counter() - t0
+    t_end = val["t_end"]
+    if not args.quiet:
+        print(f"{PROG}: scene {name}, {args.dim}D, {len(scene.pos):,} particles, arch "
+              f"{be.resolved}, {be.precision}; running to {t_end * 1e3:g} ms "
+              "(the first step compiles the kernels)", file=sys.stderr, flush=True)
+    run = simulate(sim, t_end, args.quiet)
+    obs = _observables(name, scene, sim)
+    counts = sim.counts()
+    result = {"scene": name, "dim": args.dim, "parameters": val, "gradient": args.gradient,
+              "sound_speed_m_s": scene.physics.c, "arch": be.arch,
+              "resolved_arch": be.resolved, "precision": be.precision,
+              **run_result(run, counts, setup_s), "observables": obs}
+    if args.json:
+        print(json.dumps(result, indent=2, default=float))
+        return 0
+    size = ", ".join(f"{k} {v:g}" for k, v in val.items() if k not in ("l0", "t_end"))
+    head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {size}; gradient "
+            f"{args.gradient}; arch {be.resolved}, {be.precision}")
+    print_summary(head, run, counts, scene.physics.c, setup_s, obs)
+    return 0
+
+
+def register(sub, common) -> None:
+    p = sub.add_parser("scene", formatter_class=Fmt, epilog=SCENE_EPILOG,
+                       help="run a reference scene (tank, dam-break, patch) and summarise it",
+                       description="Run a reference scene and print a summary: particles, "
+                                   "steps, dt and the limits that bound it, health, wall time.")
+    scene_sub = p.add_subparsers(dest="scene", metavar="NAME", required=True)
+    for name in SCENES:
+        q = scene_sub.add_parser(name, parents=common, formatter_class=Fmt,
+                                 epilog=SCENE_EPILOG, help=SCENE_HELP[name],
+                                 description=f"Scene {name}: {SCENE_HELP[name]}.")
+        q.add_argument("--dim", type=int, choices=(2, 3), default=2, help="dimension (default: 2)")
+        q.add_argument("--l0", type=float, metavar="M", help="particle spacing [m] (default: by --dim, below)")
+        q.add_argument("--t-end", type=float, metavar="S", help="simulated time [s] (default: below)")
+        if name == "tank":
+            q.add_argument("--width", type=float, metavar="M", help="container width [m] (default: 0.04)")
+            q.add_argument("--depth", type=float, metavar="M", help="water depth H [m] (default: 0.04)")
+            q.add_argument("--nu", type=float, metavar="NU", help="kinematic viscosity [m^2/s] (default: 1e-3, which damps the start-up waves; the hydrostatic answer does not depend on it)")
+        elif name == "dam-break":
+            q.add_argument("--a", type=float, metavar="M",
+                           help="column width a [m]; height 2a (default: 0.05 in 2D, 0.03 in 3D)")
+        else:
+            q.add_argument("--side", type=float, metavar="M", help="side of the square [m] (default: 2e-3)")
+            q.add_argument("--sigma", type=float, metavar="SIGMA", help="surface tension [N/m] (default: 0.0728)")
+        q.add_argument("--courant", type=float, default=NUMERICS.courant, metavar="X",
+                       help="velocity Courant number v dt / l0 (default: %(default)g, S5)")
+        q.add_argument("--acoustic", type=float, default=NUMERICS.acoustic, metavar="X",
+                       help="acoustic Courant number c dt / l0 (default: %(default)g, S6)")
+        q.add_argument("--gradient", choices=GRADIENT_FORMS, default="pmin",
+                       help="pressure-gradient form: seed (P_j - P_i), pmin (P_j - Pmin_i), "
+                            "sum (P_j + P_i) (default: pmin)")
+        q.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+        q.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+        q.set_defaults(func=lambda a, argv: _scene(a))
