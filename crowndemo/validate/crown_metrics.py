@@ -1,0 +1,149 @@
+"""Crown metrics measured from the fluid particles of one frame of a drop-on-film run, and the
+crown / no-crown verdict (method.md §6-7).
+
+Geometry of the crown scene (``crowndemo.scenes.crown``): the drop's axis is x = 0 (and
+y = 0), the floor surface z = 0, the undisturbed film surface z = h. In 2D the 'radius' is
+|x| and the two sides of the slice are the two 'sectors'.
+
+The rules, each a few lines below:
+- raised liquid: particles more than 2 l0 above the undisturbed film surface;
+- the main body is the largest group of particles linked at 1.5 l0; every other group above
+  the film is an ejected droplet;
+- base radius: per azimuthal sector, the outermost raised particle of the main body in the
+  root band h + 2 l0 < z < h + 5 l0 (the foot of the crown wall), the median over sectors;
+- rim height: in azimuthal bins of about 2 l0 of arc (the two sides in 2D), the highest
+  particle of the main body outside half the base radius, above h; the median over bins (the
+  rim between the fingers when fingers are narrow);
+- rim thickness: per sector, the radial extent (+ l0) of the main body in the top fifth of that
+  sector's wall; the median;
+- jets: the local maxima of the rim height around the azimuth (bins of about 2 l0 of arc),
+  each at least 2 l0 above both neighbouring minima, and ejected droplets do not count (3D);
+- verdict: a crown when a wall stands outside the drop's footprint (base radius > D/2) and
+  rises at least D/4 above the film (rim height >= D/4), as a sheet (rim thickness < rim
+  height). Otherwise no crown (a dent or a crater rim).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Optional
+
+import numpy as np
+
+from .clusters import groups
+
+RAISED_L0 = 2.0        # raised liquid: more than this many l0 above the film surface
+ROOT_TOP_L0 = 5.0      # the root band of the crown wall ends this many l0 above the surface
+LINK_L0 = 1.5          # particles closer than this many l0 belong to one body
+JET_PROMINENCE_L0 = 2.0
+CROWN_MIN_HEIGHT_D = 0.25
+CROWN_MIN_BASE_D = 0.5
+
+
+@dataclass
+class CrownMetrics:
+    time: float
+    base_radius: float          # m (nan when nothing is raised)
+    rim_height: float           # m above the undisturbed film surface
+    rim_thickness: float        # m
+    jets: int                   # fingers along the rim (3D; 0 in 2D)
+    droplets: int               # ejected groups apart from the main body
+    droplet_particles: int
+    raised_particles: int
+    crown: bool
+    verdict: str                # one line: why crown or no crown
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def _sectors(theta: np.ndarray, n: int) -> np.ndarray:
+    return np.minimum(((theta + math.pi) / (2 * math.pi) * n).astype(int), n - 1)
+
+
+def _per_sector(values: np.ndarray, sector: np.ndarray, n: int, fn) -> np.ndarray:
+    out = np.full(n, np.nan)
+    for s in np.unique(sector):
+        out[s] = fn(values[sector == s])
+    return out
+
+
+def count_jets(rim: np.ndarray, prominence: float) -> int:
+    """Peaks of a periodic profile that stand ``prominence`` above the lowest point between
+    them and the next peak on either side (nan bins are gaps at the film level)."""
+    h = np.where(np.isfinite(rim), rim, np.nanmin(rim) if np.isfinite(rim).any() else 0.0)
+    n = len(h)
+    if n < 3:
+        return 0
+    # walk round the ring from its lowest point, counting rises and falls of the prominence
+    start = int(np.argmin(h))
+    ring = np.concatenate([h[start:], h[:start], h[start:start + 1]])
+    peaks, low, high, rising = 0, ring[0], ring[0], True
+    for v in ring[1:]:
+        if rising:
+            high = max(high, v)
+            if high - v >= prominence and high - low >= prominence:
+                peaks += 1
+                rising, low = False, v
+        else:
+            low = min(low, v)
+            if v - low >= prominence:
+                rising, high = True, v
+    return peaks
+
+
+def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
+            sectors: Optional[int] = None) -> CrownMetrics:
+    """The metrics of one frame from the fluid particle positions ``pos`` (N x dim)."""
+    pos = np.asarray(pos, dtype=float)
+    dim = pos.shape[1]
+    z = pos[:, -1]
+    raised = z > film + RAISED_L0 * l0
+    nan = math.nan
+    if not raised.any():
+        return CrownMetrics(time, nan, 0.0, nan, 0, 0, 0, 0, False,
+                            "no crown: nothing stands 2 l0 above the film")
+    label = groups(pos, LINK_L0 * l0)
+    ids, counts = np.unique(label, return_counts=True)
+    main = label == ids[np.argmax(counts)]
+    drops = raised & ~main
+    n_drops = len(np.unique(label[drops]))
+    if dim == 3:
+        r = np.hypot(pos[:, 0], pos[:, 1])
+        theta = np.arctan2(pos[:, 1], pos[:, 0])
+    else:
+        r = np.abs(pos[:, 0])
+        theta = np.where(pos[:, 0] >= 0, 0.5 * math.pi, -0.5 * math.pi)
+    body = raised & main
+    root = body & (z < film + ROOT_TOP_L0 * l0)
+    if not root.any():
+        root = body
+    n_sec = 2 if dim == 2 else (sectors or 16)
+    sec = _sectors(theta, n_sec)
+    base = float(np.nanmedian(_per_sector(r[root], sec[root], n_sec, np.max)))
+    wall = body & (r > 0.5 * base)
+    if not wall.any():
+        wall = body
+    n_az = max(16, int(2 * math.pi * base / (2 * l0))) if dim == 3 else 2
+    profile = _per_sector(z[wall], _sectors(theta[wall], n_az), n_az, np.max)
+    rim_height = float(np.nanmedian(profile)) - film
+    thick = np.full(n_sec, np.nan)
+    for s in np.unique(sec[wall]):
+        m = wall & (sec == s)
+        zs = z[m]
+        upper = zs >= film + 0.8 * (zs.max() - film)
+        thick[s] = np.ptp(r[m][upper]) + l0
+    rim_thickness = float(np.nanmedian(thick))
+    jets = count_jets(profile, JET_PROMINENCE_L0 * l0) if dim == 3 else 0
+    crown = (base > CROWN_MIN_BASE_D * drop and rim_height >= CROWN_MIN_HEIGHT_D * drop
+             and rim_thickness < rim_height)
+    if crown:
+        why = (f"crown: a sheet {rim_thickness * 1e3:.2g} mm thick rises {rim_height * 1e3:.3g} mm "
+               f"(>= D/4 = {CROWN_MIN_HEIGHT_D * drop * 1e3:.3g} mm) at r = {base * 1e3:.3g} mm "
+               f"(> D/2)")
+    else:
+        why = (f"no crown: the rim rises {rim_height * 1e3:.3g} mm (a crown needs >= D/4 = "
+               f"{CROWN_MIN_HEIGHT_D * drop * 1e3:.3g} mm) at r = {base * 1e3:.3g} mm (needs > "
+               f"D/2), {rim_thickness * 1e3:.2g} mm thick (needs < its height)")
+    return CrownMetrics(time, base, rim_height, rim_thickness, jets, n_drops,
+                        int(drops.sum()), int(raised.sum()), bool(crown), why)

@@ -1,0 +1,116 @@
+"""Crown metrics on synthetic particle sets whose geometry is known exactly: a film with a
+cylindrical wall (radius, height, thickness), fingers along its rim, droplets thrown off."""
+import math
+
+import numpy as np
+import pytest
+
+from crowndemo.validate.clusters import groups
+from crowndemo.validate.crown_metrics import count_jets, measure
+
+L0 = 1.0e-4
+H = 1.0e-3          # film
+D = 4.0e-3          # drop
+
+
+def film(radius, l0=L0, h=H):
+    n = int(radius / l0)
+    ax = (np.arange(-n, n) + 0.5) * l0
+    zs = (np.arange(int(round(h / l0))) + 0.5) * l0
+    x, y, z = np.meshgrid(ax, ax, zs, indexing="ij")
+    pts = np.stack([x.ravel(), y.ravel(), z.ravel()], axis=1)
+    return pts[np.hypot(pts[:, 0], pts[:, 1]) <= radius]
+
+
+def shell(radius, thickness, top, l0=L0, h=H):
+    """A cylindrical wall from the floor up to z = top(theta), mid-radius ``radius``."""
+    pts = []
+    for r in np.arange(radius - thickness / 2 + l0 / 2, radius + thickness / 2, l0):
+        n_arc = int(2 * math.pi * r / l0)
+        theta = (np.arange(n_arc) + 0.5) * 2 * math.pi / n_arc - math.pi
+        for t in theta:
+            zs = np.arange(0.5 * l0, top(t), l0)
+            pts.append(np.stack([np.full_like(zs, r * math.cos(t)),
+                                 np.full_like(zs, r * math.sin(t)), zs], axis=1))
+    return np.concatenate(pts)
+
+
+def ball(centre, radius, l0=L0):
+    n = int(radius / l0) + 1
+    ax = np.arange(-n, n + 1) * l0
+    g = np.stack(np.meshgrid(ax, ax, ax, indexing="ij"), axis=-1).reshape(-1, 3)
+    return g[np.linalg.norm(g, axis=1) <= radius] + np.asarray(centre)
+
+
+def test_groups_match_separated_balls():
+    pts = np.concatenate([ball((0, 0, 0), 3 * L0), ball((20 * L0, 0, 0), 2 * L0),
+                          ball((0, 20 * L0, 5 * L0), L0 * 0.5)])
+    label = groups(pts, 1.5 * L0)
+    assert len(np.unique(label)) == 3
+
+
+def test_wall_gives_base_height_thickness_and_crown():
+    R, T, top = 3.0e-3, 4 * L0, H + 2.0e-3           # wall 2 mm above the film, 4 l0 thick
+    pts = np.concatenate([film(5.0e-3), shell(R, T, lambda t: top)])
+    m = measure(pts, 1e-3, H, D, L0)
+    # the foot's outermost particle sits half a spacing inside the wall's outer face
+    assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
+    assert m.rim_height == pytest.approx(top - H, abs=L0)
+    assert m.rim_thickness == pytest.approx(T, abs=1.01 * L0)
+    assert m.droplets == 0 and m.jets == 0
+    assert m.crown, m.verdict
+
+
+def test_fingers_are_counted():
+    n_jets = 12
+    def top(t):       # a 1 mm wall with 12 fingers 0.6 mm tall, 3 l0 wide
+        phase = (t + math.pi) % (2 * math.pi / n_jets)
+        return H + 1.0e-3 + (0.6e-3 if phase < 3 * L0 / 3.0e-3 else 0.0)
+    pts = np.concatenate([film(5.0e-3), shell(3.0e-3, 3 * L0, top)])
+    m = measure(pts, 1e-3, H, D, L0)
+    assert m.jets == n_jets
+    assert m.rim_height == pytest.approx(1.0e-3, abs=L0)   # the median bin: the rim between fingers
+
+
+def test_droplets_are_counted_and_not_the_body():
+    drops = [ball((3.0e-3 * math.cos(a), 3.0e-3 * math.sin(a), H + 4e-3), 1.5 * L0)
+             for a in np.linspace(0, 2 * math.pi, 5, endpoint=False)]
+    pts = np.concatenate([film(5.0e-3), shell(3.0e-3, 3 * L0, lambda t: H + 2e-3)] + drops)
+    m = measure(pts, 1e-3, H, D, L0)
+    assert m.droplets == 5
+    assert m.droplet_particles == sum(len(d) for d in drops)
+    assert m.rim_height == pytest.approx(2e-3, abs=L0)
+
+
+def test_dent_is_no_crown():
+    pts = film(5.0e-3)
+    pts = pts[~((np.hypot(pts[:, 0], pts[:, 1]) < 1.5e-3) & (pts[:, 2] > 0.5 * H))]
+    rim = shell(1.8e-3, 2 * L0, lambda t: H + 3 * L0)          # a low rim: 0.3 mm < D/4
+    m = measure(np.concatenate([pts, rim]), 1e-3, H, D, L0)
+    assert not m.crown
+    assert m.rim_height < D / 4
+    assert "no crown" in m.verdict
+
+
+def test_flat_film_has_nothing_raised():
+    m = measure(film(3.0e-3), 0.0, H, D, L0)
+    assert not m.crown and m.raised_particles == 0
+
+
+def test_2d_slice_wall():
+    xs = (np.arange(-50, 50) + 0.5) * L0
+    zs = (np.arange(10) + 0.5) * L0
+    base = np.stack(np.meshgrid(xs, zs, indexing="ij"), axis=-1).reshape(-1, 2)
+    walls = [np.stack(np.meshgrid(sx * np.array([2.85e-3, 2.95e-3, 3.05e-3]),
+                                  np.arange(0.5 * L0, H + 2e-3, L0), indexing="ij"),
+                      axis=-1).reshape(-1, 2) for sx in (-1, 1)]
+    m = measure(np.concatenate([base] + walls), 1e-3, H, D, L0)
+    assert m.base_radius == pytest.approx(3.05e-3, abs=1e-9)
+    assert m.rim_height == pytest.approx(2e-3, abs=L0)
+    assert m.crown
+
+
+def test_count_jets_on_a_profile():
+    theta = np.linspace(0, 2 * math.pi, 200, endpoint=False)
+    assert count_jets(np.cos(7 * theta), 0.5) == 7
+    assert count_jets(0.1 * np.cos(7 * theta), 0.5) == 0
