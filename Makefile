@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.crowndemo-installed
 
-.PHONY: setup vulkan demo test bench clean
+.PHONY: setup vulkan demo test validate bench clean
 
 setup: $(STAMP) vulkan
 
@@ -32,6 +32,12 @@ demo: setup
 
 test: setup
 	$(PY) -m pytest -q
+
+# The full validation suite (issue 5): every case at three resolutions and its settings
+# variants, the stability suite and the seed's crown verdicts; rewrites VALIDATION.md.
+validate: setup
+	$(PY) -m pip install --quiet -e '.[test,plot]'
+	$(VENV)/bin/crowndemo validate --record
 
 bench: setup
 	$(VENV)/bin/crowndemo bench

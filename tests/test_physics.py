@@ -6,22 +6,13 @@ import pytest
 
 from crowndemo.core import (FLUID, InstabilityError, Numerics, ParameterError, simulator_for)
 from crowndemo.scenes import circularity, dam_break, hydrostatic_tank, square_patch
+from crowndemo.validate.cases import fluid_pressure_profile
+from crowndemo.validate.observables import surge_front
 
 RHO, G = 998.0, 9.81
 
 # Martin & Moyce (1952), column a x 2a: (T = t sqrt(2g/a), Z = front / a), T <= 3 (method.md §7)
 MARTIN_MOYCE = [(0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995)]
-
-
-def _fluid_pressure_profile(sim, width, depth, l0):
-    """Least-squares fit P = P0 - k z over fluid particles away from walls and free surface."""
-    sim.refresh_pressure()
-    s = sim.snapshot()
-    p, P, kind = s["pos"], s["pressure"], s["kind"]
-    inner = (kind == FLUID) & np.all((p[:, :-1] > 3 * l0) & (p[:, :-1] < width - 3 * l0), axis=1)
-    inner &= (p[:, -1] > 3 * l0) & (p[:, -1] < depth - 4 * l0)
-    slope, p0 = np.polyfit(p[inner, -1], P[inner], 1)
-    return -slope, p0
 
 
 @pytest.mark.parametrize("dim,l0,width,depth", [(2, 1.0e-3, 0.04, 0.04),
@@ -32,7 +23,7 @@ def test_hydrostatic_tank(dim, l0, width, depth):
     scene = hydrostatic_tank(dim=dim, l0=l0, width=width, depth=depth, nu=1.0e-3)
     sim = simulator_for(scene)
     sim.run(0.25)
-    k, p_floor = _fluid_pressure_profile(sim, width, depth, l0)
+    k, p_floor = fluid_pressure_profile(sim, width, depth, l0)
     assert p_floor == pytest.approx(RHO * G * depth, rel=0.05)       # P(0) = rho g H
     assert k == pytest.approx(RHO * G, rel=0.05)                      # dP/dz = -rho g
     h = sim.stats.health
@@ -48,12 +39,10 @@ def test_dam_break_surge_front_2d():
     front = []
 
     def record(s, i):
-        # the leading edge of the liquid: spray (particles with under half a neighbourhood,
-        # n < n0/2) is not the surge front
-        s.refresh_pressure()
+        # the front of the continuous liquid (the connected body); particles thrown ahead of
+        # it are spray, not the surge front Martin & Moyce photographed
         snap = s.snapshot()
-        liquid = (snap["kind"] == FLUID) & (snap["number_density"] >= 0.5 * s.lattice.n0)
-        front.append((snap["pos"][liquid, 0].max() + 0.5 * l0) / a)
+        front.append(surge_front(snap["pos"][snap["kind"] == FLUID], l0) / a)
 
     sim.run(MARTIN_MOYCE[-1][0] / scale, frame_times=[T / scale for T, _ in MARTIN_MOYCE],
             on_frame=record)
@@ -62,8 +51,13 @@ def test_dam_break_surge_front_2d():
     ritter = np.array([1 + 2 * T for T, _ in MARTIN_MOYCE])   # inviscid shallow-water front
     assert np.all(np.diff(z) > 0)
     assert np.all(z < ritter)
-    # Issue 2 asks for 10 %; this solver's front leads the experiment by 13-16 % at every
-    # resolution and setting tried (see the README's validation status); held to 20 % here.
+    # Issue 2 asks for 10 %. The front of the connected body leads the experiment by 7-18 %
+    # for T <= 3 whatever the front measure, initial state (zero or hydrostatic pressure),
+    # gradient form, c or l0 (README, validation status); Koshizuka & Oka's (1996) experiment
+    # agrees with Martin & Moyce, so the lead is the model's (effectively inviscid: water's
+    # boundary layer, ~0.2 mm, is far below l0; nu = 1e-4 would slow the front into 10 %, but
+    # that is not water), and no documented physical source for a correction was found
+    # (no time shift without one). Held to 20 % until one is.
     assert np.all(np.abs(z / ref - 1) < 0.20), (z, ref)
 
 

@@ -20,11 +20,13 @@ from ..backend import BackendError  # noqa: E402
 from ..config import PresetError  # noqa: E402
 from ..core.health import InstabilityError  # noqa: E402
 from ..core.params import ParameterError  # noqa: E402
+from ..render.window import RenderError  # noqa: E402
 from .common import (PROG, Fmt, Parser, UsageError, backend_options, error,  # noqa: E402
                      parameter_message)
 
 # the command modules, in the order `crowndemo --help` lists them
-COMMANDS = ["presets", "info", "run", "scene", "bench"]
+COMMANDS = ["presets", "info", "run", "record", "export", "play", "live", "scene", "validate",
+            "sweep", "bench"]
 
 MAIN_EPILOG = """\
 examples:
@@ -64,7 +66,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return e.code if isinstance(e.code, int) else 0
     try:
         return args.func(args, argv)
-    except (UsageError, PresetError, BackendError) as e:
+    except (UsageError, PresetError, BackendError, RenderError) as e:
         return error(str(e))
     except ParameterError as e:
         return error(parameter_message(e))

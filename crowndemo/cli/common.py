@@ -71,48 +71,77 @@ def fmt_counts(counts: Dict[str, int]) -> str:
 
 
 class StopRun(Exception):
-    """Raised from the step callback to end a run early (--max-steps)."""
+    """Raised from the step callback to end a run early (--max-steps, Ctrl-C)."""
+
+    def __init__(self, by: str = "max-steps"):
+        super().__init__(by)
+        self.by = by
+
+
+class Progress:
+    """A step callback: a progress line on stderr every ~2 s (simulated time, steps/s, ETA);
+    the first step of the process's run (it compiles the kernels) is timed apart."""
+
+    def __init__(self, t_end: float, quiet: bool, max_steps: Optional[int] = None,
+                 first_label: str = "first step (compiling)"):
+        self.t_end, self.quiet, self.max_steps = t_end, quiet, max_steps
+        self.first_label = first_label
+        self.started = time.perf_counter()
+        self.first_step_s: Optional[float] = None
+        self.mark = (self.started, 0, 0.0)      # wall, steps, simulated time
+
+    def __call__(self, s) -> None:
+        now = time.perf_counter()
+        st = s.stats
+        if self.first_step_s is None:          # compiling: not in the rate
+            self.first_step_s = now - self.started
+            if not self.quiet:
+                print(f"  {self.first_label} {self.first_step_s:.1f} s", file=sys.stderr,
+                      flush=True)
+            self.mark = (now, st.steps, st.time)
+            return
+        t_mark, steps_mark, sim_mark = self.mark
+        if self.quiet or now - t_mark < PROGRESS_EVERY_S:
+            return
+        rate = (st.steps - steps_mark) / (now - t_mark)
+        sim_rate = (st.time - sim_mark) / (now - t_mark)
+        left = (self.t_end - st.time) / sim_rate if sim_rate > 0 else math.inf
+        if self.max_steps is not None and rate > 0:
+            left = min(left, (self.max_steps - st.steps) / rate)
+        print(f"  t = {st.time * 1e3:8.3f} / {self.t_end * 1e3:g} ms  step {st.steps:6d}"
+              f"  {rate:7.1f} steps/s  ETA {clock(left)}  max speed "
+              f"{st.health.max_speed:.3g} m/s", file=sys.stderr, flush=True)
+        self.mark = (now, st.steps, st.time)
 
 
 def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
              max_steps: Optional[int] = None,
-             on_frame: Optional[Callable[[object, int], None]] = None) -> Dict:
-    """Run ``sim`` to ``t_end`` (or ``max_steps``) with a progress line on stderr every ~2 s
-    (simulated time, steps/s, ETA); returns the stats, the peak health figures and whether
-    the run stopped early."""
+             on_frame: Optional[Callable[[object, int], None]] = None,
+             stop=None, first_label: str = "first step (compiling)") -> Dict:
+    """Run ``sim`` to ``t_end`` (or ``max_steps``, or until ``stop.requested``: Ctrl-C) with a
+    progress line on stderr every ~2 s; returns the stats, the peak health figures, whether
+    and why the run stopped early (stopped_by: max-steps | ctrl-c) and the first step's time."""
     h0 = sim.stats.health
     peak = {"speed": h0.max_speed, "excess": h0.max_density_excess}
-    prog = {"t": time.perf_counter(), "steps": 0, "sim_t": 0.0}
+    progress = Progress(t_end, quiet, max_steps, first_label)
 
     def on_step(s):
         h = s.stats.health
         peak["speed"] = max(peak["speed"], h.max_speed)
         peak["excess"] = max(peak["excess"], h.max_density_excess)
-        now = time.perf_counter()
-        if s.stats.steps == 1:          # the first step compiles the kernels: not in the rate
-            if not quiet:
-                print(f"  first step (compiling) {now - prog['t']:.1f} s", file=sys.stderr,
-                      flush=True)
-            prog["t"], prog["steps"], prog["sim_t"] = now, 1, s.stats.time
-        elif not quiet and now - prog["t"] >= PROGRESS_EVERY_S:
-            rate = (s.stats.steps - prog["steps"]) / (now - prog["t"])
-            sim_rate = (s.stats.time - prog["sim_t"]) / (now - prog["t"])
-            left = (t_end - s.stats.time) / sim_rate if sim_rate > 0 else math.inf
-            if max_steps is not None and rate > 0:
-                left = min(left, (max_steps - s.stats.steps) / rate)
-            print(f"  t = {s.stats.time * 1e3:8.3f} / {t_end * 1e3:g} ms  step {s.stats.steps:6d}"
-                  f"  {rate:7.1f} steps/s  ETA {clock(left)}  max speed {h.max_speed:.3g} m/s",
-                  file=sys.stderr, flush=True)
-            prog["t"], prog["steps"], prog["sim_t"] = now, s.stats.steps, s.stats.time
+        progress(s)
         if max_steps is not None and s.stats.steps >= max_steps:
-            raise StopRun
+            raise StopRun("max-steps")
+        if stop is not None and stop.requested:
+            raise StopRun("ctrl-c")
 
-    stopped = False
+    stopped_by = None
     try:
         stats = sim.run(t_end, frame_times=frame_times, on_frame=on_frame, on_step=on_step)
-    except StopRun:
-        stats, stopped = sim.stats, True
-    return {"stats": stats, "peak": peak, "stopped_early": stopped}
+    except StopRun as e:
+        stats, stopped_by = sim.stats, e.by
+    return {"stats": stats, "peak": peak, "stopped_early": stopped_by is not None,
+            "stopped_by": stopped_by, "first_step_s": progress.first_step_s}
 
 
 def clock(seconds: float) -> str:
@@ -144,7 +173,8 @@ def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: flo
     left = ", ".join(f"{v} {k}" for k, v in h.left.items()) or "none"
     print(head)
     print(f"  particles   {fmt_counts(counts)}")
-    early = " (stopped early: --max-steps)" if run.get("stopped_early") else ""
+    early = {"max-steps": " (stopped early: --max-steps)", "ctrl-c": " (interrupted: Ctrl-C)"
+             }.get(run.get("stopped_by"), "")
     print(f"  simulated   {stats.time * 1e3:.4g} ms in {stats.steps:,} steps{early}; dt "
           f"{stats.dt_min:.3g} .. {stats.dt_max:.3g} s; steps bound by: {binding}")
     print(f"  health      max speed {h.max_speed:.4g} m/s (peak {peak['speed']:.4g}, "
@@ -169,8 +199,33 @@ def load_preset(spec: str, args, quality: Optional[str] = None):
     return config.load(spec, quality or args.quality or config.DEFAULT_QUALITY, args.sets)
 
 
+CTRL_C_NOTICE = f"{PROG}: Ctrl-C: stopping after this step (press it again to stop at once)"
+
+
+def add_sequence_options(p) -> None:
+    """--then and --playlist: several presets, one after another, in one process."""
+    p.add_argument("--then", action="extend", nargs="+", default=[], metavar="PRESET",
+                   help="presets to run afterwards, one after another in this process "
+                        "(one compiled simulator per model, reused)")
+    p.add_argument("--playlist", metavar="FILE",
+                   help="a file with one preset per line (# comments), run after PRESET and "
+                        "--then")
+
+
+def load_presets(args) -> list:
+    """PRESET, --then and --playlist resolved, every mistake found before any run."""
+    from .. import config
+    from ..config.playlist import read_playlist
+
+    quality = args.quality or config.DEFAULT_QUALITY
+    specs = [(s, "command line") for s in [args.preset] + list(args.then or [])]
+    if getattr(args, "playlist", None):
+        specs += read_playlist(args.playlist)
+    return [config.load(spec, quality, args.sets, source) for spec, source in specs]
+
+
 def repo_root() -> str:
-    return os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    return os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 def error(message: str) -> int:

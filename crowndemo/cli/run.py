@@ -1,4 +1,4 @@
-"""``crowndemo run``: simulate presets one after another and summarise each."""
+"""``crowndemo run``: simulate presets one after another in one session and summarise each."""
 from __future__ import annotations
 
 import json
@@ -7,8 +7,8 @@ import time
 
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
-from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, load_preset, print_summary, run_result, simulate,
-                     start_backend)
+from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, add_sequence_options,
+                     load_presets, print_summary, run_result, simulate, start_backend)
 
 
 RUN_EPILOG = """\
@@ -17,58 +17,93 @@ examples:
   crowndemo run 3m-drop --quality booth             # the seed's first run, ~289k particles
   crowndemo run 3m-drop --set scene.speed=6 --set quality.draft.t_end=5e-4
   crowndemo run quick --then quick-2d 20cm-drop     # one after another, one process
+  crowndemo run quick --playlist booth.txt          # then the presets listed in a file
   crowndemo run my-preset.yaml                      # a file; it may `extends: 3m-drop`
   crowndemo run 2m-drop --arch cuda --quality seed  # ~11.7M particles, on a GPU
 
 --quality and --set apply to every preset of the run. Every preset is checked before the
 first one starts; a mistake is reported as
   crowndemo: error: FILE: KEY = VALUE: WHY; allowed: RANGE
+The runs share one session: presets with the same compiled model (dimension, terms,
+gradient form) reuse one simulator, its kernels and fields; only the values change. Each
+summary gives the start-up time (set-up + first step) and whether kernels were compiled.
 A progress line (simulated time, steps/s, ETA) goes to stderr every ~2 s; the summary to
-stdout. An unstable run stops with exit status 3 and says what broke.
+stdout. Ctrl-C stops after the current step, prints the summary so far and exits 130 (run
+keeps no checkpoint: use 'crowndemo record' for a run you may want to resume). An
+unstable run stops with exit status 3 and says what broke.
 """
 
 
 def _run(args) -> int:
-    from ..core import simulator_for
+    from ..control import Session, compiled_kernels
+    from ..interrupt import StopRequest
 
     if args.max_steps is not None and args.max_steps < 1:
         raise ParameterError("max_steps", args.max_steps, "an integer >= 1", "command line")
-    specs = [args.preset] + list(args.then or [])
-    resolved = [load_preset(spec, args) for spec in specs]     # every mistake before any run
+    resolved = load_presets(args)                # every mistake before any run
     be = start_backend(args)
+    session = Session()
+    stop = StopRequest(CTRL_C_NOTICE)
     results = []
     t_all = time.perf_counter()
-    for i, r in enumerate(resolved):
-        t0 = time.perf_counter()
-        scene = r.build_scene()
-        sim = simulator_for(scene)
-        setup_s = time.perf_counter() - t0
-        if not args.quiet:
-            nth = f" ({i + 1} of {len(resolved)})" if len(resolved) > 1 else ""
-            print(f"{PROG}: run {r.name}{nth}, quality {r.quality}, {r.dim}D, "
-                  f"{scene.counts()['fluid']:,} fluid of {len(scene.pos):,} particles, arch "
-                  f"{be.resolved}, {be.precision}; running to {r.t_end * 1e3:g} ms "
-                  "(the first step compiles the kernels)", file=sys.stderr, flush=True)
-        run = simulate(sim, r.t_end, args.quiet, r.frame_times(), args.max_steps)
-        counts = sim.counts()
-        s = r.scene
-        results.append({
-            "preset": r.name, "file": r.label, "quality": r.quality, "dim": r.dim,
-            "l0_m": r.l0, "speed_m_s": r.speed, "film_m": s["film"], "drop_m": s["drop"],
-            "t_end_s": r.t_end, "gradient": r.numerics.pressure_gradient,
-            "sound_speed_m_s": scene.physics.c, "arch": be.arch, "resolved_arch": be.resolved,
-            "precision": be.precision, "stopped_early": run["stopped_early"],
-            **run_result(run, counts, setup_s), "left_out": scene.info.get("left_out", [])})
-        if not args.json:
-            head = (f"preset {r.name} ({r.quality}): {r.dim}D, l0 = {r.l0:g} m, U = "
-                    f"{r.speed:.4g} m/s, film {s['film']:g} m, drop {s['drop']:g} m; gradient "
-                    f"{r.numerics.pressure_gradient}; arch {be.resolved}, {be.precision}")
-            print_summary(head, run, counts, scene.physics.c, setup_s)
+    with stop.catching():
+        for i, r in enumerate(resolved):
+            t0 = time.perf_counter()
+            kernels0, built0 = compiled_kernels(), session.constructions
+            scene = r.build_scene()
+            sim = session.load(scene)
+            setup_s = time.perf_counter() - t0
+            reused = session.constructions == built0
+            if not args.quiet:
+                nth = f" ({i + 1} of {len(resolved)})" if len(resolved) > 1 else ""
+                how = ("reusing the compiled simulator" if reused else
+                       "the first step compiles the kernels")
+                print(f"{PROG}: run {r.name}{nth}, quality {r.quality}, {r.dim}D, "
+                      f"{scene.counts()['fluid']:,} fluid of {len(scene.pos):,} particles, arch "
+                      f"{be.resolved}, {be.precision}; running to {r.t_end * 1e3:g} ms ({how})",
+                      file=sys.stderr, flush=True)
+            run = simulate(sim, r.t_end, args.quiet, r.frame_times(), args.max_steps, stop=stop,
+                           first_label="first step" + ("" if reused else " (compiling)"))
+            counts = sim.counts()
+            s = r.scene
+            first = run["first_step_s"] or 0.0
+            results.append({
+                "preset": r.name, "file": r.label, "quality": r.quality, "dim": r.dim,
+                "l0_m": r.l0, "speed_m_s": r.speed, "film_m": s["film"], "drop_m": s["drop"],
+                "t_end_s": r.t_end, "gradient": r.numerics.pressure_gradient,
+                "sound_speed_m_s": scene.physics.c, "arch": be.arch,
+                "resolved_arch": be.resolved, "precision": be.precision,
+                "stopped_early": run["stopped_early"], "stopped_by": run["stopped_by"],
+                **run_result(run, counts, setup_s),
+                "startup": {"seconds": setup_s + first, "setup_seconds": setup_s,
+                            "first_step_seconds": first, "reused_simulator": reused,
+                            "kernels_compiled": compiled_kernels() - kernels0,
+                            "session": session.events[-1]},
+                "left_out": scene.info.get("left_out", [])})
+            if not args.json:
+                head = (f"preset {r.name} ({r.quality}): {r.dim}D, l0 = {r.l0:g} m, U = "
+                        f"{r.speed:.4g} m/s, film {s['film']:g} m, drop {s['drop']:g} m; "
+                        f"gradient {r.numerics.pressure_gradient}; arch {be.resolved}, "
+                        f"{be.precision}")
+                print_summary(head, run, counts, scene.physics.c, setup_s)
+                st = results[-1]["startup"]
+                print(f"  start-up    {st['seconds']:.2f} s (set-up {setup_s:.2f} s + first step "
+                      f"{first:.2f} s); {st['session']}; {st['kernels_compiled']} kernels "
+                      "compiled")
+            if run["stopped_by"] == "ctrl-c":
+                left = [x.name for x in resolved[i + 1:]]
+                print(f"{PROG}: interrupted at t = {sim.stats.time * 1e3:.4g} ms (step "
+                      f"{sim.stats.steps:,}) of {r.name}" +
+                      (f"; not run: {', '.join(left)}" if left else "") +
+                      f". 'run' keeps no checkpoint; to be able to resume, record instead: "
+                      f"'{PROG} record {r.name}', then '{PROG} record {r.name} --resume'",
+                      file=sys.stderr)
+                break
     if args.json:
         print(json.dumps(results[0] if len(results) == 1 else results, indent=2, default=float))
     elif len(results) > 1:
         print(f"{len(results)} runs in {time.perf_counter() - t_all:.2f} s")
-    return 0
+    return 130 if stop.requested else 0
 
 
 def register(sub, common) -> None:
@@ -84,11 +119,10 @@ def register(sub, common) -> None:
                         "(the seed's ~12M particles, a GPU) (default: %(default)s)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help=SET_HELP)
-    p.add_argument("--then", action="extend", nargs="+", default=[], metavar="PRESET",
-                   help="presets to run afterwards, one after another in this process")
+    add_sequence_options(p)
     p.add_argument("--max-steps", type=int, metavar="N",
                    help="stop each run after N steps (a smoke test)")
     p.add_argument("--json", action="store_true",
-                   help="print the summary as one JSON object (a list with --then)")
+                   help="print the summary as one JSON object (a list with several presets)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=lambda a, argv: _run(a))

@@ -22,7 +22,9 @@ class CellGrid:
         d = self.dim = state.dim
         self.reach = int(cells_per_re)      # cells of side re/reach; walk (2 reach + 1)^d
         self.state = state
-        self.max_cells = int(max_cells)
+        self.max_cells = int(max_cells)     # cells allocated
+        self.cell_limit = ti.field(ti.i32, shape=())   # cells used at most (<= max_cells)
+        self.cell_limit[None] = self.max_cells
         self.lo = ti.field(float, d)
         self.hi = ti.field(float, d)
         self.origin = ti.field(float, d)
@@ -40,6 +42,11 @@ class CellGrid:
         self.particle_cell = ti.field(ti.i32, state.capacity)
         self.rank = ti.field(ti.i32, state.capacity)
         self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
+
+    def set_cell_limit(self, cells: int) -> None:
+        """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
+        grid allocated larger gives the same cells, and results, as one allocated to fit."""
+        self.cell_limit[None] = min(int(cells), self.max_cells)
 
     def nbytes(self) -> int:
         from .state import field_nbytes
@@ -86,8 +93,9 @@ class CellGrid:
             cells = 1.0
             for k in ti.static(range(d)):
                 cells *= (self.hi[k] - self.lo[k]) / h + 2.0
-            while cells > self.max_cells:
-                h *= ti.max(1.01, (cells / self.max_cells) ** (1.0 / d))
+            limit = self.cell_limit[None]
+            while cells > limit:
+                h *= ti.max(1.01, (cells / limit) ** (1.0 / d))
                 cells = 1.0
                 for k in ti.static(range(d)):
                     cells *= (self.hi[k] - self.lo[k]) / h + 2.0

@@ -77,6 +77,17 @@ class Health:
     def reset(self) -> None:
         self.istats.fill(0)
 
+    def counters(self) -> np.ndarray:
+        """The cumulative counters (non-finite, then particles parked per exit reason)."""
+        return self.istats.to_numpy()
+
+    def set_counters(self, values: np.ndarray) -> None:
+        """Put back what ``counters`` returned (a restarted run keeps counting from there)."""
+        values = np.asarray(values, dtype=np.int32)
+        if values.shape != tuple(self.istats.shape):
+            raise ValueError(f"health counters: {values.shape} does not fit {self.istats.shape}")
+        self.istats.from_numpy(values)
+
     @ti.kernel
     def _reduce(self):
         """Per block of particles, then over the blocks: no contended atomics on the stats."""

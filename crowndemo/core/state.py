@@ -81,6 +81,33 @@ class ParticleState:
         order = np.argsort(pid, kind="stable")
         return {name: f.to_numpy()[:n][order] for name, f in self._persistent.items()}
 
+    # ---- a restartable copy (checkpoints) ----------------------------------------------
+    def dump(self) -> Dict[str, np.ndarray]:
+        """Every persistent field in storage order, the first n entries: with ``restore`` a
+        run continues exactly as if it had not stopped."""
+        n = self.count
+        return {name: f.to_numpy()[:n] for name, f in self._persistent.items()}
+
+    def restore(self, arrays: Dict[str, np.ndarray]) -> None:
+        """Put back what ``dump`` returned; the slots beyond n become GONE."""
+        missing = sorted(set(self._persistent) - set(arrays))
+        if missing:
+            raise ValueError(f"particle state lacks {', '.join(missing)}")
+        n = len(arrays["kind"])
+        if n > self.capacity:
+            raise ValueError(f"{n} particles exceed the capacity {self.capacity}")
+        for name, f in self._persistent.items():
+            full, a = f.to_numpy(), np.asarray(arrays[name])
+            if a.shape != (n,) + full.shape[1:] or a.dtype != full.dtype:
+                raise ValueError(f"particle field {name}: {a.dtype}{list(a.shape)} does not fit "
+                                 f"{full.dtype}{[n] + list(full.shape[1:])} (another precision "
+                                 "or dimension?)")
+            full[:n] = a
+            if name == "kind":
+                full[n:] = GONE
+            f.from_numpy(full)
+        self.n[None] = n
+
     # ---- the one permutation of every persistent field -----------------------------------
     def permute(self, order: ti.Field) -> None:
         """Field[k] <- Field[order[k]] for k < n, for every persistent field."""

@@ -2,6 +2,7 @@
 the simulator that owns the fields and runs steps to an end time."""
 from __future__ import annotations
 
+import copy
 import math
 import time as _time
 from array import array
@@ -36,6 +37,7 @@ class RunStats:
     dt_log: array = field(default_factory=lambda: array("d"))     # dt of every step
     bound_log: array = field(default_factory=lambda: array("B"))  # its binding limit (index)
     wall_seconds: float = 0.0
+    first_step_seconds: float = 0.0   # the first step of a simulator compiles its kernels
     energy_start: Optional[float] = None
     health: HealthReport = field(default_factory=HealthReport)
 
@@ -50,6 +52,11 @@ class RunStats:
                            "left_domain": dict(h.left), "nonfinite": h.nonfinite}}
 
 
+def default_max_cells(particles: int) -> int:
+    """The cell grid's size limit for a number of particles (the cell side grows past it)."""
+    return max(2 * particles, 4096)
+
+
 class Simulator:
     """Holds one compiled step. ``configure`` changes run-time values without recompiling;
     the compiled terms (``Model``) are fixed at construction."""
@@ -61,7 +68,8 @@ class Simulator:
         self.model = Model.of(physics, numerics)
         dim = physics.dim
         self.state = ParticleState(dim, capacity)
-        self.grid = CellGrid(self.state, max_cells or max(2 * capacity, 4096))
+        self._auto_cells = max_cells is None    # then the cell limit follows the particles
+        self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity))
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.predictor = Predictor(self.model, self.grid, self.coef)
@@ -95,15 +103,34 @@ class Simulator:
 
     def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
         self.state.load(pos, vel, kind)
+        if self._auto_cells:    # as for a simulator sized to these particles (same results)
+            self.grid.set_cell_limit(default_max_cells(len(pos)))
         self.n_fluid = int((np.asarray(kind) == FLUID).sum())
         self.health.reset()
         self.stats = RunStats()
         self._last = self._measure()
         self.stats.energy_start = self._last.energy
 
+    def save_state(self) -> dict:
+        """What a restarted run needs to take exactly the same path: the persistent particle
+        fields in storage order (the re-sort depends on it), the health counters, the run
+        statistics (``steps`` drives the re-sort schedule) and the last health report (its
+        max speed sets the next dt). The values of ``configure`` are not included."""
+        return {"particles": self.state.dump(), "health_counters": self.health.counters(),
+                "stats": copy.deepcopy(self.stats), "n_fluid": self.n_fluid}
+
+    def restore_state(self, saved: dict) -> None:
+        """Continue from ``save_state``'s result; call ``configure`` with the same values first."""
+        self.state.restore(saved["particles"])
+        self.health.set_counters(saved["health_counters"])
+        self.stats = copy.deepcopy(saved["stats"])
+        self._last = self.stats.health
+        self.n_fluid = int(saved["n_fluid"])
+
     # ---- the step ------------------------------------------------------------------------
     def step(self, dt_cap: float = math.inf) -> float:
         """Advance one step; returns dt. Raises InstabilityError on a broken health limit."""
+        t_first = _time.perf_counter() if self.stats.steps == 0 else None
         dt, binding = timestep.choose(self.physics, self.numerics, self.model,
                                       self._last.max_speed)
         if dt_cap < dt:
@@ -126,6 +153,8 @@ class Simulator:
         s.dt_log.append(dt)
         s.bound_log.append(BINDINGS.index(binding))
         self._last = self._measure()
+        if t_first is not None:
+            s.first_step_seconds = _time.perf_counter() - t_first
         Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
                      sound_speed=self.physics.c, max_mach=self.numerics.max_mach,
                      max_density_excess=self.numerics.max_density_excess,

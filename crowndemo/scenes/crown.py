@@ -25,9 +25,12 @@ def crown_base_radius(t: float, U: float, D: float, h: float) -> float:
 
 def reach_radius(t_end: float, U: float, D: float, h: float, gap: float) -> float:
     """How far from the axis the liquid can be disturbed by t_end: twice the crown base radius
-    at the end time (the film ahead of the crown is pushed too), at least the drop, plus 2 mm."""
+    at the end time (the film ahead of the crown is pushed too), at least the drop, plus 2 mm.
+    Yarin & Weiss's radius grows without bound as h -> 0; a film thinner than D/10 (a dry floor
+    included) is taken as D/10, which bounds a lamella spreading on a dry floor (r/D of about
+    1.1 sqrt(t U / D), Rioboo et al. 2002) with a margin."""
     t_impact = gap / U
-    return max(2.0 * crown_base_radius(t_end - t_impact, U, D, h), D) + 2.0e-3
+    return max(2.0 * crown_base_radius(t_end - t_impact, U, D, max(h, 0.1 * D)), D) + 2.0e-3
 
 
 def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 1.0e-2,

@@ -1,0 +1,97 @@
+"""``crowndemo export``: a recording as ParaView files (.vtp per frame + a .pvd series)."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from ..config import QUALITIES
+from .common import PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError, load_preset, \
+    start_backend
+
+EXPORT_EPILOG = """\
+examples:
+  crowndemo export quick --vtk                     # recordings/quick -> recordings/quick/vtk/
+  crowndemo export 3m-drop --vtk --out /tmp/crown  # somewhere else
+  crowndemo export quick --vtk --recordings runs   # from runs/quick
+
+Reads RECORDINGS/PRESET (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
+./recordings): the frames listed in its metadata.json. When there is no recording, the
+preset is recorded first (as 'crowndemo record PRESET' with the same --quality, --set and
+backend options), then exported. An interrupted recording exports the frames it has.
+
+Writes OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
+data: velocity, pressure, number_density, kind, id; 2D runs get z = 0) and OUT/PRESET.pvd
+(every frame with its time in s): open the .pvd in ParaView. frame_*.vtp files in OUT that
+are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk.
+With --quality or --set, an existing recording must have been made with the same values.
+"""
+
+
+def _export(args) -> int:
+    from ..record import METADATA, RecordError, recording_dir, recordings_root, vtk
+    from ..record.metadata import read as read_metadata
+    from ..record.recorder import fingerprint, record_preset
+
+    if not args.vtk:
+        raise UsageError("choose a format: --vtk (ParaView .vtp + .pvd)")
+    r = load_preset(args.preset, args)
+    root = Path(args.recordings) if args.recordings else recordings_root()
+    folder = recording_dir(r.name, root)
+    meta = read_metadata(folder / METADATA)
+    code = 0
+    if meta is None:
+        print(f"{PROG}: no recording in {folder}: recording {r.name} ({r.quality}) first",
+              file=sys.stderr, flush=True)
+        be = start_backend(args)
+        try:
+            res = record_preset(r, folder, on_step=Progress(r.t_end, args.quiet), backend=be)
+        except RecordError as e:
+            raise UsageError(str(e)) from None
+        if not res.complete:
+            print(f"{PROG}: the recording ended {res.status}", file=sys.stderr)
+            code = 3 if res.status.startswith("unstable") else 130
+        meta = read_metadata(folder / METADATA)
+    elif args.quality is not None or args.sets:
+        from ..record.checkpoint import differences
+        diff = differences(meta.get("fingerprint") or {}, fingerprint(r, args.precision))
+        if diff:
+            raise UsageError(f"{folder} was recorded with other values ({'; '.join(diff[:3])})"
+                             f"; record it again or leave out --quality/--set")
+    files = [folder / f["file"] for f in meta["frames"]]
+    missing = [str(f) for f in files if not f.is_file()]
+    if missing:
+        raise UsageError(f"{folder}: metadata.json lists frames that are missing: "
+                         f"{', '.join(missing[:3])}")
+    if not files:
+        raise UsageError(f"{folder}: the recording has no frame yet")
+    out = Path(args.out) if args.out else folder / "vtk"
+    keep = {f"{f.stem}.vtp" for f in files}
+    for old in out.glob("frame_*.vtp"):
+        if old.name not in keep:
+            old.unlink()
+    pvd = vtk.export(files, out, r.name)
+    state = "" if meta["complete"] else f" (the recording is {meta['status']})"
+    print(f"{PROG}: wrote {len(files)} frames, t = {meta['frames'][0]['time_s'] * 1e3:g} .. "
+          f"{meta['frames'][-1]['time_s'] * 1e3:g} ms, to {out}{state}; open {pvd} in ParaView",
+          file=sys.stderr)
+    return code
+
+
+def register(sub, common) -> None:
+    p = sub.add_parser("export", parents=common, formatter_class=Fmt, epilog=EXPORT_EPILOG,
+                       help="write a recording as ParaView files (.vtp per frame + .pvd)",
+                       description="Export a recording's frames for ParaView; records the "
+                                   "preset first when there is no recording.")
+    p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
+    p.add_argument("--vtk", action="store_true",
+                   help="VTK XML: frame_NNNNN.vtp per frame and PRESET.pvd (the one format)")
+    p.add_argument("--out", metavar="DIR", help="output folder (default: RECORDINGS/PRESET/vtk)")
+    p.add_argument("--recordings", metavar="DIR",
+                   help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
+                        "./recordings)")
+    p.add_argument("--quality", choices=QUALITIES, default=None,
+                   help="quality rung, when recording first (default: draft)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help=SET_HELP + " (when recording first)")
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.set_defaults(func=lambda a, argv: _export(a))

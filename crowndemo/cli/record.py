@@ -1,0 +1,218 @@
+"""``crowndemo record``: simulate presets and save their frames, checkpoint and metadata into
+recordings/PRESET/, or resume an interrupted recording."""
+from __future__ import annotations
+
+import json
+import os
+import shlex
+import sys
+from pathlib import Path
+from typing import List
+
+from ..config import DEFAULT_QUALITY, QUALITIES
+from ..core.params import ParameterError
+from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError,
+                     add_sequence_options, load_presets, print_summary, start_backend)
+
+RECORD_EPILOG = """\
+examples:
+  crowndemo record quick                          # recordings/quick/: frames + metadata.json
+  crowndemo record 3m-drop --quality booth        # ~289k particles, 17 frames
+  crowndemo record quick --then quick-2d          # one after another, one compiled session
+  crowndemo record 2m-drop --playlist booth.txt   # then the presets listed in the file
+  crowndemo record 3m-drop --resume               # continue after Ctrl-C (same options)
+  crowndemo record quick --set scene.t_end=5e-4 --checkpoint-every 4
+
+Output in RECORDINGS/PRESET/ (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
+./recordings): frames/frame_NNNNN.png (rendered offscreen with GGUI; needs a Vulkan driver,
+e.g. Debian's mesa-vulkan-drivers; --no-render skips it), video.mp4 and preview.gif (made
+when the recording completes; an incomplete one gets video.partial.mp4), and
+snapshots/frame_NNNNN.npz (particles at t = 0 and every frame interval;
+fluid only unless --all-particles), checkpoint.npz (the full state, for --resume) and
+metadata.json (parameters, particle counts, dt, health, wall time, versions, frames, and
+status: running, complete, interrupted or unstable). Recording a preset afresh replaces
+its earlier recording (said on stderr). Files are written under a temporary name and
+renamed, so a file that exists is whole.
+
+Ctrl-C stops after the current step: the frames so far are kept, a checkpoint is saved,
+metadata.json says "interrupted", and the command prints how to resume (exit 130). A
+resumed run with --single-thread ends bit for bit where an uninterrupted one would.
+An unstable run keeps its frames, marks metadata.json "unstable: ..." and exits 3.
+"""
+
+
+def extra_sinks(resolved, folder: Path, args) -> List:
+    """Frame sinks that run after the snapshot of each frame: the renderer (PNG frames, then
+    the MP4 and GIF), unless --no-render. Checks Vulkan before any simulation time is spent."""
+    from ..render import sink_from_args
+    sink = sink_from_args(args, resolved, os.fspath(folder), resume=args.resume)
+    return [sink] if sink is not None else []
+
+
+def _spec(r) -> str:
+    """How to name the preset again: its name if that finds the same file, else its path."""
+    from ..config import PresetError, find
+    try:
+        return r.name if find(r.name) == r.doc.path else r.label
+    except PresetError:
+        return r.label
+
+
+def _resume_command(r, args) -> str:
+    words = [PROG, "record", _spec(r)]
+    if args.quality != DEFAULT_QUALITY:
+        words += ["--quality", args.quality]
+    for s in args.sets:
+        words += ["--set", s]
+    if args.recordings:
+        words += ["--recordings", args.recordings]
+    for opt in ("arch", "precision"):
+        if getattr(args, opt) not in (None, "f32"):
+            words += [f"--{opt}", getattr(args, opt)]
+    if args.single_thread:
+        words.append("--single-thread")
+    return " ".join(shlex.quote(w) for w in words + ["--resume"])
+
+
+def _record(args) -> int:
+    from ..control import Session
+    from ..interrupt import StopRequest
+    from ..record import RecordError, recording_dir, recordings_root
+    from ..record.recorder import record_preset
+
+    if args.max_steps is not None and args.max_steps < 1:
+        raise ParameterError("max_steps", args.max_steps, "an integer >= 1", "command line")
+    if args.checkpoint_every < 0:
+        raise UsageError(f"--checkpoint-every {args.checkpoint_every}: allowed: an integer >= 0 "
+                         "(frames between checkpoints; 0: only when interrupted)")
+    resolved = load_presets(args)                # every mistake before any run
+    names = [r.name for r in resolved]
+    twice = sorted({n for n in names if names.count(n) > 1})
+    if twice:
+        raise UsageError(f"{', '.join(twice)} listed twice: each preset records into "
+                         "RECORDINGS/PRESET, so the second would replace the first")
+    if args.resume and len(resolved) > 1:
+        raise UsageError("--resume takes one PRESET (no --then or --playlist)")
+    root = Path(args.recordings) if args.recordings else recordings_root()
+    be = start_backend(args)
+    session = Session()
+    stop = StopRequest(CTRL_C_NOTICE)
+    out = []
+    with stop.catching():
+        for i, r in enumerate(resolved):
+            folder = recording_dir(r.name, root)
+            progress = Progress(r.t_end, args.quiet, args.max_steps)
+
+            def announce(res, i=i, r=r):
+                if res.replaced_frames:
+                    print(f"{PROG}: replacing the earlier recording in {folder} "
+                          f"({res.replaced_frames} frames)", file=sys.stderr)
+                if args.quiet:
+                    return
+                nth = f" ({i + 1} of {len(resolved)})" if len(resolved) > 1 else ""
+                c = res.scene.counts()
+                how = (f"resuming at t = {res.resumed.time * 1e3:.4g} ms, step "
+                       f"{res.resumed.steps:,}, frame {res.resumed.next_frame}"
+                       if res.resumed else f"{len(res.frame_times)} frames")
+                print(f"{PROG}: record {r.name}{nth} into {folder}, quality {r.quality}, "
+                      f"{r.dim}D, {c['fluid']:,} fluid of {c['total']:,} particles, arch "
+                      f"{be.resolved}, {be.precision}; to {r.t_end * 1e3:g} ms, {how}; "
+                      f"{session.events[-1]}", file=sys.stderr, flush=True)
+
+            render = extra_sinks(r, folder, args)
+            try:
+                res = record_preset(r, folder, render, args.resume,
+                                    session=session, checkpoint_every=args.checkpoint_every,
+                                    fluid_only=not args.all_particles, max_steps=args.max_steps,
+                                    on_step=progress, on_start=announce, stop=stop, backend=be)
+            except RecordError as e:
+                raise UsageError(str(e)) from None
+            meta = json.loads((folder / "metadata.json").read_text())
+            if render:
+                meta = _add_render_timing(folder, meta, render[0], res)
+            out.append({"folder": str(folder), **meta})
+            if not args.json:
+                run = {"stats": res.sim.stats, "stopped_by": res.log.stopped_by,
+                       "peak": {"speed": res.log.peak_max_speed,
+                                "excess": res.log.peak_max_density_excess}}
+                head = (f"preset {r.name} ({r.quality}): {r.dim}D, l0 = {r.l0:g} m, U = "
+                        f"{r.speed:.4g} m/s; arch {be.resolved}, {be.precision}")
+                print_summary(head, run, res.sim.counts(), res.scene.physics.c,
+                              res.log.setup_seconds)
+                print(f"  recording   {folder}: {len(res.log.frames)} of "
+                      f"{len(res.frame_times)} frames; status {res.status.split(':')[0]}")
+            if render and not args.json:
+                t = meta["render"]
+                print(f"  rendering   {t['frames']} frames, {t['render_seconds_per_frame']:.2f} s "
+                      f"a frame against {t['simulation_seconds_per_frame']:.2f} s of simulation "
+                      f"a frame; video and preview {t['encode_seconds']:.1f} s: "
+                      f"{', '.join(os.path.basename(v) for v in t['outputs'].values()) or 'none'}")
+            if res.status.startswith("unstable"):
+                print(f"{PROG}: {res.error}", file=sys.stderr)
+                print(f"{PROG}: kept {len(res.log.frames)} frames in {folder}", file=sys.stderr)
+                _dump(out, args)
+                return 3
+            if not res.complete:
+                t, k = res.sim.stats.time, res.sim.stats.steps
+                print(f"{PROG}: interrupted ({res.log.stopped_by}) at t = {t * 1e3:.4g} ms, step "
+                      f"{k:,}; kept {len(res.log.frames)} frames in {folder}; to resume: "
+                      f"{_resume_command(r, args)}", file=sys.stderr)
+                _dump(out, args)
+                return 130 if res.log.stopped_by == "ctrl-c" else 0
+    _dump(out, args)
+    return 0
+
+
+def _add_render_timing(folder: Path, meta: dict, sink, res) -> dict:
+    """Render time per frame set against simulation time per frame (stepping only), written
+    into metadata.json: rendering must not dominate a recording."""
+    from ..record.files import atomic_write_json
+
+    timing = sink.timing()
+    frames = max(timing["frames"], 1)
+    timing["simulation_seconds_per_frame"] = res.sim.stats.wall_seconds / frames
+    timing["outputs"] = {k: os.path.basename(v) for k, v in sink.outputs.items()}
+    meta["render"] = timing
+    atomic_write_json(folder / "metadata.json", meta)
+    return meta
+
+
+def _dump(out, args) -> None:
+    if args.json:
+        print(json.dumps(out[0] if len(out) == 1 else out, indent=2))
+
+
+def register(sub, common) -> None:
+    p = sub.add_parser("record", parents=common, formatter_class=Fmt, epilog=RECORD_EPILOG,
+                       help="run a preset and save its rendered frames, video, snapshots, "
+                            "checkpoint and metadata",
+                       description="Record a preset: simulate it and write, at every frame, "
+                                   "a rendered image and the particles, then a video, a "
+                                   "checkpoint and metadata.json into "
+                                   "RECORDINGS/PRESET/; --resume continues after Ctrl-C.")
+    p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
+    p.add_argument("--quality", choices=QUALITIES, default=DEFAULT_QUALITY,
+                   help="quality rung (default: %(default)s)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help=SET_HELP)
+    add_sequence_options(p)
+    p.add_argument("--resume", action="store_true",
+                   help="continue from RECORDINGS/PRESET/checkpoint.npz (give the same "
+                        "--quality, --set and --precision as the first time)")
+    p.add_argument("--recordings", metavar="DIR",
+                   help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
+                        "./recordings); each preset goes to DIR/PRESET")
+    p.add_argument("--checkpoint-every", type=int, default=1, metavar="K",
+                   help="save the checkpoint every K frames; 0: only when interrupted "
+                        "(default: 1)")
+    p.add_argument("--all-particles", action="store_true",
+                   help="snapshots with wall and dummy particles too (default: fluid only)")
+    p.add_argument("--max-steps", type=int, metavar="N",
+                   help="stop at step N (counted from t = 0) as if interrupted: a checkpoint "
+                        "is saved and --resume continues (exit 0)")
+    p.add_argument("--json", action="store_true",
+                   help="print metadata.json (a list with several presets)")
+    from ..render import add_render_options
+    add_render_options(p)
+    p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
+    p.set_defaults(func=lambda a, argv: _record(a))

@@ -1,0 +1,133 @@
+"""Checkpoints: the full restartable state of a recording in one ``checkpoint.npz``.
+
+It holds every persistent particle field in storage order (exit reasons and parked particles
+included), the health counters, the run statistics with the dt and binding logs, the last
+health report (which sets the next dt), the run log (frames, peaks, wall times), the index of
+the next frame, and a fingerprint of the parameters, so that ``--resume`` refuses a checkpoint
+of other parameters. With ``Simulator.restore_state`` the resumed run takes the same steps as
+an uninterrupted one (bit for bit on one thread).
+"""
+from __future__ import annotations
+
+import json
+from array import array
+from collections import Counter
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Dict, List
+
+import numpy as np
+
+from ..core.health import HealthReport
+from ..core.step import RunStats
+from .files import PathLike, atomic_write
+from .runlog import RunLog
+from .sinks import INTERRUPTED
+
+FORMAT = 1
+
+
+class CheckpointError(ValueError):
+    """A checkpoint that is missing, unreadable or of other parameters."""
+
+
+@dataclass
+class Checkpoint:
+    saved: dict               # Simulator.save_state()
+    log: RunLog
+    next_frame: int
+    fingerprint: dict
+
+    @property
+    def time(self) -> float:
+        return self.saved["stats"].time
+
+    @property
+    def steps(self) -> int:
+        return self.saved["stats"].steps
+
+
+def _stats_json(s: RunStats) -> dict:
+    return {"steps": s.steps, "time": s.time, "dt_min": s.dt_min, "dt_max": s.dt_max,
+            "binding": dict(s.binding), "wall_seconds": s.wall_seconds,
+            "energy_start": s.energy_start, "health": asdict(s.health)}
+
+
+def _stats_from(d: dict, dt_log: np.ndarray, bound_log: np.ndarray) -> RunStats:
+    return RunStats(steps=d["steps"], time=d["time"], dt_min=d["dt_min"], dt_max=d["dt_max"],
+                    binding=Counter(d["binding"]), dt_log=array("d", dt_log.tolist()),
+                    bound_log=array("B", bound_log.tolist()), wall_seconds=d["wall_seconds"],
+                    energy_start=d["energy_start"], health=HealthReport(**d["health"]))
+
+
+def save(path: PathLike, saved: dict, log: RunLog, next_frame: int, fingerprint: dict) -> None:
+    """Write ``Simulator.save_state()`` and the run log atomically to ``path``."""
+    stats = saved["stats"]
+    meta = {"format": FORMAT, "next_frame": next_frame, "fingerprint": fingerprint,
+            "stats": _stats_json(stats), "n_fluid": saved["n_fluid"], "log": log.to_json()}
+    arrays = {f"particles/{k}": v for k, v in saved["particles"].items()}
+    arrays.update(health_counters=saved["health_counters"],
+                  dt_log=np.asarray(stats.dt_log, dtype=np.float64),
+                  bound_log=np.asarray(stats.bound_log, dtype=np.uint8),
+                  meta=np.array(json.dumps(meta)))
+    atomic_write(path, lambda f: np.savez_compressed(f, **arrays))
+
+
+def load(path: PathLike) -> Checkpoint:
+    path = Path(path)
+    if not path.is_file():
+        raise CheckpointError(f"{path}: no checkpoint to resume from")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            meta = json.loads(str(z["meta"]))
+            if meta.get("format") != FORMAT:
+                raise CheckpointError(f"{path}: checkpoint format {meta.get('format')!r}; this "
+                                      f"version reads format {FORMAT}")
+            particles = {k.split("/", 1)[1]: z[k] for k in z.files if k.startswith("particles/")}
+            saved = {"particles": particles, "health_counters": z["health_counters"],
+                     "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"]),
+                     "n_fluid": meta["n_fluid"]}
+    except (OSError, KeyError, ValueError) as e:
+        if isinstance(e, CheckpointError):
+            raise
+        raise CheckpointError(f"{path}: unreadable checkpoint ({e})") from None
+    return Checkpoint(saved, RunLog.from_json(meta["log"]), int(meta["next_frame"]),
+                      meta["fingerprint"])
+
+
+def differences(saved: dict, now: dict, prefix: str = "") -> List[str]:
+    """Keys whose values differ between two fingerprints, as 'key: saved -> now'."""
+    out = []
+    for k in sorted(set(saved) | set(now)):
+        a, b = saved.get(k), now.get(k)
+        if isinstance(a, dict) and isinstance(b, dict):
+            out += differences(a, b, f"{prefix}{k}.")
+        elif a != b:
+            out.append(f"{prefix}{k}: {a!r} -> {b!r}")
+    return out
+
+
+class CheckpointSink:
+    """Saves a checkpoint every ``every`` frames (0: never) and when the run is interrupted."""
+
+    def __init__(self, path: PathLike, sim, log: RunLog, fingerprint: Dict, every: int = 1,
+                 next_frame: int = 0):
+        if every < 0:
+            raise ValueError(f"checkpoint every {every} frames; allowed: an integer >= 0")
+        self.path, self.sim, self.log = Path(path), sim, log
+        self.fingerprint, self.every, self.next_frame = fingerprint, every, next_frame
+
+    def frame(self, sim, index: int, time: float) -> None:
+        self.next_frame = index + 1
+        if self.every and index % self.every == 0:
+            self.save()
+
+    def save(self) -> None:
+        save(self.path, self.sim.save_state(), self.log, self.next_frame, self.fingerprint)
+
+    def close(self, status: str) -> None:
+        if status == INTERRUPTED:      # stopped between steps: a consistent state
+            self.save()
+
+
+__all__ = ["Checkpoint", "CheckpointError", "CheckpointSink", "save", "load", "differences"]

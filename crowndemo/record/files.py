@@ -1,0 +1,68 @@
+"""Where recordings live and how their files are written: every file goes to a temporary name
+in the same folder and is renamed into place, so a file that stands under its name is whole."""
+from __future__ import annotations
+
+import json
+import os
+from pathlib import Path
+from typing import BinaryIO, Callable, Union
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+METADATA = "metadata.json"
+CHECKPOINT = "checkpoint.npz"
+SNAPSHOTS = "snapshots"
+
+
+def recordings_root() -> Path:
+    """``$CROWNDEMO_RECORDINGS``, else ``recordings/`` in the working directory."""
+    return Path(os.environ.get("CROWNDEMO_RECORDINGS") or "recordings")
+
+
+def recording_dir(name: str, root: PathLike = None) -> Path:
+    return Path(root if root is not None else recordings_root()) / name
+
+
+def frame_name(index: int, suffix: str = ".npz") -> str:
+    return f"frame_{index:05d}{suffix}"
+
+
+def frame_index(path: PathLike) -> int:
+    """The index in ``frame_00042.npz`` (ValueError for another name)."""
+    stem = Path(path).stem
+    if not stem.startswith("frame_"):
+        raise ValueError(f"{path}: not a frame file (frame_NNNNN)")
+    return int(stem[len("frame_"):])
+
+
+def atomic_write(path: PathLike, write: Callable[[BinaryIO], None]) -> None:
+    """Call ``write(file)`` on a temporary file next to ``path``, then rename it to ``path``."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    try:
+        with open(tmp, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+
+
+def atomic_write_text(path: PathLike, text: str) -> None:
+    atomic_write(path, lambda f: f.write(text.encode("utf-8")))
+
+
+def atomic_write_json(path: PathLike, data) -> None:
+    atomic_write_text(path, json.dumps(data, indent=2, default=_jsonable) + "\n")
+
+
+def _jsonable(x):
+    """numpy scalars and other numbers json does not know."""
+    if hasattr(x, "item"):
+        return x.item()
+    if isinstance(x, Path):
+        return str(x)
+    raise TypeError(f"{type(x).__name__} is not JSON serialisable")

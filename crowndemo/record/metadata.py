@@ -1,0 +1,115 @@
+"""``metadata.json``: what a recording is and how far it got.
+
+Written (atomically) when the run starts with ``complete: false, status: "running"``, again at
+every frame, and at the end with the final status: "complete", "interrupted" or
+"unstable: <message>". A run killed outright therefore leaves ``complete: false``.
+"""
+from __future__ import annotations
+
+import json
+import math
+import platform
+from dataclasses import asdict
+from pathlib import Path
+from typing import Optional
+
+from .files import CHECKPOINT, PathLike, atomic_write_json
+from .runlog import RunLog
+from .sinks import COMPLETE, RUNNING
+
+FORMAT = 1
+
+
+def versions() -> dict:
+    import numpy
+    import taichi
+
+    from .. import __version__
+    return {"crowndemo": __version__, "taichi": ".".join(map(str, taichi.__version__)),
+            "numpy": numpy.__version__, "python": platform.python_version()}
+
+
+def finite_or_none(x):
+    """JSON has no Infinity or NaN: non-finite floats become null (recursively)."""
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    if isinstance(x, dict):
+        return {str(k): finite_or_none(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [finite_or_none(v) for v in x]
+    return x
+
+
+def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoint_every: int,
+          backend=None, fingerprint: Optional[dict] = None) -> dict:
+    """The metadata of a recording as a dict (JSON-ready)."""
+    s, h = sim.stats, sim.stats.health
+    kw = resolved.crown_kwargs()
+    kw["numerics"] = asdict(kw["numerics"])
+    be = backend
+    return finite_or_none({
+        "format": FORMAT,
+        "complete": status == COMPLETE, "status": status, "stopped_by": log.stopped_by,
+        "preset": resolved.name, "file": resolved.label, "extends_chain": resolved.doc.chain,
+        "quality": resolved.quality, "dim": resolved.dim, "title": resolved.title,
+        "parameters": {"values": resolved.values, "crown": kw,
+                       "sources": {k: {"key": key, "file": src}
+                                   for k, (key, src) in sorted(resolved.where.items())}},
+        "physics": asdict(scene.physics), "sound_speed_m_s": scene.physics.c,
+        "model": resolved.model.describe(),
+        "particles": {"initial": scene.counts(), "now": sim.counts()},
+        "left_out": scene.info.get("left_out", []), "scene_info": scene.info,
+        "t_end_s": resolved.t_end, "simulated_s": s.time, "steps": s.steps,
+        "dt": {"min_s": s.dt_min, "max_s": s.dt_max, "binding_limits": dict(s.binding)},
+        "health": {"max_speed_m_s": h.max_speed, "max_density_excess": h.max_density_excess,
+                   "peak_max_speed_m_s": log.peak_max_speed,
+                   "peak_max_density_excess": log.peak_max_density_excess,
+                   "energy_start_J": s.energy_start, "energy_J": h.energy,
+                   "left_domain": dict(h.left), "left_domain_total": h.left_total,
+                   "nonfinite": h.nonfinite},
+        "wall_seconds": {"setup": log.setup_seconds, "stepping": s.wall_seconds,
+                         "starts": log.starts},
+        "versions": versions(),
+        "backend": None if be is None else {"arch": be.arch, "resolved_arch": be.resolved,
+                                            "precision": be.precision, "seed": be.seed,
+                                            "single_thread": be.single_thread},
+        "frames_planned": [{"index": i, "time_s": t} for i, t in enumerate(frame_times)],
+        "frames": log.frames,
+        "checkpoint": {"file": CHECKPOINT, "every_frames": checkpoint_every},
+        "fingerprint": fingerprint,
+    })
+
+
+class MetadataSink:
+    """Rewrites metadata.json at every frame and at the end."""
+
+    def __init__(self, path: PathLike, resolved, scene, sim, log: RunLog, frame_times,
+                 checkpoint_every: int, backend=None, fingerprint: Optional[dict] = None):
+        self.path = Path(path)
+        self.args = (resolved, scene, sim, log)
+        self.frame_times, self.every, self.backend = list(frame_times), checkpoint_every, backend
+        self.fingerprint = fingerprint
+
+    def write(self, status: str) -> dict:
+        data = build(*self.args, status, self.frame_times, self.every, self.backend,
+                     self.fingerprint)
+        atomic_write_json(self.path, data)
+        return data
+
+    def frame(self, sim, index: int, time: float) -> None:
+        self.write(RUNNING)
+
+    def close(self, status: str) -> None:
+        self.write(status)
+
+
+def read(path: PathLike) -> Optional[dict]:
+    """metadata.json as a dict; None when there is none."""
+    path = Path(path)
+    if not path.is_file():
+        return None
+    with open(path, encoding="utf-8") as f:
+        return json.load(f)
+
+
+__all__ = ["MetadataSink", "build", "read", "versions"]

@@ -1,0 +1,166 @@
+"""``record_preset``: run a preset and hand every frame to a list of sinks (snapshots, any
+extra sinks such as a renderer, the checkpoint, metadata.json), or resume such a run."""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Callable, List, Optional, Sequence
+
+from ..core.health import InstabilityError
+from . import checkpoint as ckpt
+from . import snapshots
+from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike
+from .metadata import MetadataSink, finite_or_none
+from .runlog import RunLog
+from .sinks import COMPLETE, INTERRUPTED, unstable
+
+
+class RecordError(ValueError):
+    """A recording that cannot be made or resumed as asked (one line, for the user)."""
+
+
+class _Stopped(Exception):
+    def __init__(self, by: str):
+        self.by = by
+
+
+@dataclass
+class RecordResult:
+    status: str                     # complete | interrupted | unstable: ... | failed: ...
+    folder: Path
+    resolved: object
+    scene: object
+    sim: object
+    log: RunLog
+    frame_times: List[float]
+    resumed: Optional[ckpt.Checkpoint] = None
+    error: Optional[BaseException] = None
+    replaced_frames: int = 0        # frames of an earlier recording removed at the start
+
+    @property
+    def complete(self) -> bool:
+        return self.status == COMPLETE
+
+
+def frame_times(resolved) -> List[float]:
+    """The recorded frames: t = 0 and every frame interval to the end time."""
+    return [0.0] + list(resolved.frame_times())
+
+
+def fingerprint(resolved, precision: str) -> dict:
+    """What must not change between a checkpoint and its resumption (JSON-normal form)."""
+    kw = resolved.crown_kwargs()
+    kw["numerics"] = asdict(kw["numerics"])
+    data = {"preset": resolved.name, "quality": resolved.quality, "precision": precision,
+            "crown": kw, "frame_times": frame_times(resolved)}
+    return json.loads(json.dumps(finite_or_none(data)))
+
+
+def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resume: bool = False,
+                  *, session=None, checkpoint_every: int = 1, fluid_only: bool = True,
+                  max_steps: Optional[int] = None, on_step: Optional[Callable] = None,
+                  on_start: Optional[Callable] = None, stop=None,
+                  backend=None) -> RecordResult:
+    """Record ``resolved`` (a config.Resolved) into ``out_dir``; returns how it ended.
+
+    ``sinks_extra`` are frame sinks called after the snapshot and before the checkpoint and
+    metadata. ``resume`` continues from ``out_dir/checkpoint.npz`` (RecordError if there is
+    none or it was made with other parameters). ``stop`` is an object whose ``requested``
+    turns true to stop after the current step (Ctrl-C); ``max_steps`` stops at that step
+    count (resumed steps included); both end "interrupted" with a checkpoint to resume from.
+    An InstabilityError ends "unstable: ..." (returned in ``error``, not raised); frames
+    written so far are kept. ``on_step(sim)`` runs after every step (progress), ``on_start(
+    result)`` once the simulator is loaded.
+    """
+    from .. import backend as backend_mod
+    from ..control import Session
+
+    t0 = time.perf_counter()
+    be = backend or backend_mod.current()
+    folder = Path(out_dir)
+    frames = frame_times(resolved)
+    print_ = fingerprint(resolved, be.precision)
+    saved = None
+    replaced = 0
+    if resume:
+        try:
+            saved = ckpt.load(folder / CHECKPOINT)
+        except ckpt.CheckpointError as e:
+            raise RecordError(f"{e}; record without --resume to start afresh") from None
+        diff = ckpt.differences(saved.fingerprint, print_)
+        if diff:
+            raise RecordError(f"{folder / CHECKPOINT} was made with other parameters ("
+                              f"{'; '.join(diff[:4])}{'; ...' if len(diff) > 4 else ''}); "
+                              "resume with the same preset, --quality, --set and --precision, "
+                              "or record without --resume")
+        snapshots.remove_from(folder / SNAPSHOTS, saved.next_frame)   # re-made from here
+    else:
+        replaced = snapshots.remove_from(folder / SNAPSHOTS, 0)
+        for name in (CHECKPOINT, METADATA):
+            (folder / name).unlink(missing_ok=True)
+    folder.mkdir(parents=True, exist_ok=True)
+
+    session = session or Session()
+    scene = resolved.build_scene()
+    sim = session.load(scene)
+    if saved is not None:
+        sim.restore_state(saved.saved)
+        log, start = saved.log, saved.next_frame
+    else:
+        log, start = RunLog(), 0
+        log.note_health(sim.stats.health)
+    result = RecordResult("running", folder, resolved, scene, sim, log, frames, saved,
+                          replaced_frames=replaced)
+    checkpoint = ckpt.CheckpointSink(folder / CHECKPOINT, sim, log, print_, checkpoint_every,
+                                     start)
+    meta = MetadataSink(folder / METADATA, resolved, scene, sim, log, frames, checkpoint_every,
+                        be, print_)
+    sinks = [snapshots.SnapshotSink(folder, log, fluid_only), *sinks_extra, checkpoint, meta]
+    log.start(sim.stats.steps, time.perf_counter() - t0)
+    log.stopped_by = None
+    meta.write("running")
+    if on_start:
+        on_start(result)
+
+    def on_frame(s, i: int) -> None:
+        index = start + i
+        for sink in sinks:
+            sink.frame(s, index, frames[index])
+
+    def after_step(s) -> None:
+        log.note_health(s.stats.health)
+        if on_step:
+            on_step(s)
+        if max_steps is not None and s.stats.steps >= max_steps:
+            raise _Stopped("max-steps")
+        if stop is not None and stop.requested:
+            raise _Stopped("ctrl-c")
+
+    closing = sinks
+    try:
+        if max_steps is not None and sim.stats.steps >= max_steps:
+            raise _Stopped("max-steps")
+        sim.run(resolved.t_end, frames[start:], on_frame=on_frame, on_step=after_step)
+        status = COMPLETE
+    except _Stopped as e:
+        status, log.stopped_by = INTERRUPTED, e.by
+    except InstabilityError as e:
+        status, result.error = unstable(str(e)), e
+    except KeyboardInterrupt as e:    # a second Ctrl-C, perhaps inside a step: no checkpoint
+        status, log.stopped_by, result.error = INTERRUPTED, "ctrl-c (at once)", e
+        closing = [k for k in sinks if k is not checkpoint]
+    except Exception as e:
+        status, result.error = f"failed: {type(e).__name__}: {e}", e
+        closing = [k for k in sinks if k is not checkpoint]
+    result.status = status
+    for sink in closing:
+        sink.close(status)
+    if isinstance(result.error, (KeyboardInterrupt, Exception)) and not isinstance(
+            result.error, InstabilityError):
+        raise result.error
+    return result
+
+
+__all__ = ["record_preset", "RecordResult", "RecordError", "fingerprint", "frame_times"]

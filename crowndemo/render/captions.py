@@ -1,0 +1,187 @@
+"""Text on images, with Pillow: the caption of each frame (preset title, simulated time, drop
+speed and fall height) and the title cards of the booth loop, in English or Japanese.
+
+Japanese needs a CJK font. One is looked for in the usual Debian places (fonts-ipafont-gothic,
+fonts-noto-cjk, ...) or taken from $CROWNDEMO_FONT; without one, Japanese text falls back to
+English with a one-time warning that says how to install a font.
+"""
+from __future__ import annotations
+
+import glob
+import os
+import sys
+import textwrap
+from dataclasses import dataclass
+from typing import Dict, List, Optional, Tuple
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+
+LANGS = ("en", "ja")
+LATIN_FONTS = ("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+               "/usr/share/fonts/TTF/DejaVuSans.ttf")
+CJK_FONTS = ("/usr/share/fonts/opentype/ipafont-gothic/ipagp.ttf",
+             "/usr/share/fonts/opentype/ipafont-gothic/ipag.ttf",
+             "/usr/share/fonts/truetype/fonts-japanese-gothic.ttf",
+             "/usr/share/fonts/opentype/noto/NotoSansCJK-Regular.ttc",
+             "/usr/share/fonts/opentype/noto/NotoSansCJKjp-Regular.otf",
+             "/usr/share/fonts/truetype/vlgothic/VL-PGothic-Regular.ttf",
+             "/usr/share/fonts/truetype/droid/DroidSansFallbackFull.ttf")
+CJK_GLOBS = ("/usr/share/fonts/**/*ipag*.ttf", "/usr/share/fonts/**/*CJK*.tt[cf]",
+             "/usr/share/fonts/**/*CJK*.otf")
+CJK_HINT = ("no Japanese (CJK) font found, so Japanese text is shown in English; install one "
+            "with 'apt-get install fonts-ipafont-gothic' (about 12 MB installed) or point "
+            "$CROWNDEMO_FONT at a .ttf/.otf/.ttc file")
+TEXT = (240, 240, 240)
+DIM_TEXT = (190, 196, 205)
+BAND = (0, 0, 0, 150)
+CARD_BACKGROUND = (14, 16, 22)
+MARKER = (230, 80, 60)
+_warned = False
+
+
+def cjk_font_path() -> Optional[str]:
+    env = os.environ.get("CROWNDEMO_FONT")
+    if env and os.path.isfile(env):
+        return env
+    for path in CJK_FONTS:
+        if os.path.isfile(path):
+            return path
+    for pattern in CJK_GLOBS:
+        found = sorted(glob.glob(pattern, recursive=True))
+        if found:
+            return found[0]
+    return None
+
+
+def effective_lang(lang: str) -> str:
+    """``lang``, or 'en' (with a one-time warning on stderr) when Japanese has no font."""
+    global _warned
+    if lang not in LANGS:
+        raise ValueError(f"language {lang!r} is not one of {', '.join(LANGS)}")
+    if lang == "ja" and cjk_font_path() is None:
+        if not _warned:
+            print(f"crowndemo: warning: {CJK_HINT}", file=sys.stderr)
+            _warned = True
+        return "en"
+    return lang
+
+
+def font(lang: str, size: int) -> ImageFont.FreeTypeFont:
+    """A font for ``lang`` (a CJK font covers Latin too) at ``size`` pixels."""
+    candidates = ([cjk_font_path()] if lang == "ja" else []) + list(LATIN_FONTS)
+    for path in candidates:
+        if path and os.path.isfile(path):
+            return ImageFont.truetype(path, size)
+    return ImageFont.load_default(size=size)       # Pillow's own scalable font
+
+
+def text_in(texts, lang: str) -> str:
+    """A text given as one string or {en: ..., ja: ...}, in ``lang`` (else English)."""
+    if isinstance(texts, dict):
+        return texts.get(lang) or texts.get("en") or next(iter(texts.values()), "")
+    return str(texts or "")
+
+
+@dataclass(frozen=True)
+class CaptionInfo:
+    """What a frame's caption says about the run."""
+    title: Dict[str, str]
+    speed: float                    # m/s
+    gravity: float                  # m/s^2
+
+    @classmethod
+    def from_resolved(cls, resolved) -> "CaptionInfo":
+        return cls(dict(resolved.title) if isinstance(resolved.title, dict)
+                   else {"en": str(resolved.title)}, resolved.speed,
+                   resolved.scene["gravity"])
+
+    @property
+    def height(self) -> Optional[float]:
+        """The fall height that gives the impact speed without drag: U^2 / (2 g)."""
+        return self.speed ** 2 / (2 * self.gravity) if self.gravity > 0 else None
+
+
+def _length(metres: float) -> str:
+    return f"{metres:.2f} m" if metres >= 1 else f"{metres * 100:.3g} cm"
+
+
+def caption_lines(info: CaptionInfo, time: float, lang: str) -> List[str]:
+    """The caption's two lines: the title, then time, speed and height."""
+    t = f"t = {time * 1e3:.3f} ms"
+    u = f"U = {info.speed:.3g} m/s"
+    h = info.height
+    if lang == "ja":
+        parts = [t, f"衝突速度 {u}"] + ([f"落下高さ U²/2g = {_length(h)}"] if h else [])
+        return [text_in(info.title, "ja"), "　".join(parts)]
+    parts = [t, f"drop speed {u}"] + ([f"fall height U²/2g = {_length(h)}"] if h else [])
+    return [text_in(info.title, "en"), "   ".join(parts)]
+
+
+def draw_caption(image: np.ndarray, info: CaptionInfo, time: float, lang: str = "en",
+                 marker: Optional[str] = None) -> np.ndarray:
+    """The image (h, w, 3 uint8) with a caption band across its top; a new array."""
+    lang = effective_lang(lang)
+    img = Image.fromarray(image).convert("RGBA")
+    h = img.height
+    big, small = font(lang, max(10, h // 24)), font(lang, max(8, h // 36))
+    title, line = caption_lines(info, time, lang)
+    pad = max(4, h // 60)
+    band_h = pad * 3 + big.size + small.size
+    overlay = Image.new("RGBA", img.size, (0, 0, 0, 0))
+    d = ImageDraw.Draw(overlay)
+    d.rectangle([0, 0, img.width, band_h], fill=BAND)
+    d.text((pad * 2, pad), title, font=big, fill=TEXT)
+    d.text((pad * 2, pad * 2 + big.size), line, font=small, fill=DIM_TEXT)
+    if marker:
+        _marker(d, img.size, marker, small, pad)
+    return np.asarray(Image.alpha_composite(img, overlay).convert("RGB"))
+
+
+def _marker(d: ImageDraw.ImageDraw, size: Tuple[int, int], text: str, f, pad: int) -> None:
+    """A red label in the bottom-right corner (an incomplete recording)."""
+    x0, y0, x1, y1 = d.textbbox((0, 0), text, font=f)
+    w, h = x1 - x0 + 2 * pad, y1 - y0 + 2 * pad
+    box = [size[0] - w - pad, size[1] - h - pad, size[0] - pad, size[1] - pad]
+    d.rectangle(box, fill=MARKER + (220,))
+    d.text((box[0] + pad - x0, box[1] + pad - y0), text, font=f, fill=(255, 255, 255))
+
+
+def mark(image: np.ndarray, text: str, lang: str = "en") -> np.ndarray:
+    """The image with a red label in its bottom-right corner; a new array."""
+    img = Image.fromarray(image).convert("RGBA")
+    overlay = Image.new("RGBA", img.size, (0, 0, 0, 0))
+    h = img.height
+    _marker(ImageDraw.Draw(overlay), img.size, text, font(effective_lang(lang), max(9, h // 28)),
+            max(4, h // 60))
+    return np.asarray(Image.alpha_composite(img, overlay).convert("RGB"))
+
+
+def title_card(size: Tuple[int, int], title, description, lang: str = "en",
+               marker: Optional[str] = None) -> np.ndarray:
+    """A card (h, w, 3 uint8): the title large, the description wrapped beneath it."""
+    lang = effective_lang(lang)
+    w, h = size
+    img = Image.new("RGBA", (w, h), CARD_BACKGROUND + (255,))
+    d = ImageDraw.Draw(img)
+    big, small = font(lang, max(12, h // 14)), font(lang, max(9, h // 28))
+    title_text, desc_text = text_in(title, lang), text_in(description, lang)
+    # wrap the description to about 80 % of the width (by characters of the average width)
+    avg = max(1.0, d.textlength("あ" if lang == "ja" else "n", font=small))
+    lines = textwrap.wrap(desc_text, max(8, int(0.8 * w / avg))) if desc_text else []
+    lines = lines[:6]
+    gap = small.size // 2
+    block = big.size + 2 * gap + len(lines) * (small.size + gap)
+    y = (h - block) // 2
+    d.text((w // 2, y), title_text, font=big, fill=TEXT, anchor="ma")
+    y += big.size + 2 * gap
+    for line in lines:
+        d.text((w // 2, y), line, font=small, fill=DIM_TEXT, anchor="ma")
+        y += small.size + gap
+    if marker:
+        _marker(d, (w, h), marker, small, max(4, h // 60))
+    return np.asarray(img.convert("RGB"))
+
+
+__all__ = ["LANGS", "CJK_HINT", "CaptionInfo", "caption_lines", "draw_caption", "title_card", "mark",
+           "cjk_font_path", "effective_lang", "font", "text_in"]

@@ -1,0 +1,54 @@
+"""What colour a particle gets: the colour fields, their fixed scales, the colour map.
+
+Scales are fixed for a whole run (not stretched frame by frame) so that a colour means the same
+thing in every frame: speed over [0, U], height over [0, h + D], pressure over [0, rho U^2];
+``milk`` is a white-ish colour, slightly brighter with height, that the lighting shades.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+MODES = ("speed", "height", "pressure", "milk")
+MODE_CODE = {m: i for i, m in enumerate(MODES)}
+DEFAULT_MODE = "speed"
+
+# colour map stops, low -> high: blue, cyan, green, yellow, red (bright ends on a dark ground)
+COLOUR_MAP = np.array([[0.15, 0.35, 0.85], [0.10, 0.70, 0.90], [0.35, 0.85, 0.45],
+                       [0.98, 0.80, 0.20], [0.90, 0.25, 0.10]], dtype=np.float32)
+MILK_LOW = (0.86, 0.85, 0.81)      # milk at the floor
+MILK_HIGH = (1.00, 0.99, 0.95)     # milk at the top of the height scale
+UNITS = {"speed": "m/s", "height": "m", "pressure": "Pa", "milk": "m"}
+
+
+@dataclass(frozen=True)
+class ColourScale:
+    mode: str
+    lo: float
+    hi: float
+
+    @property
+    def code(self) -> int:
+        return MODE_CODE[self.mode]
+
+    @classmethod
+    def for_scene(cls, mode: str, speed: float, film: float, drop: float,
+                  rho: float) -> "ColourScale":
+        if mode not in MODES:
+            raise ValueError(f"colour {mode!r} is not one of {', '.join(MODES)}")
+        hi = {"speed": speed, "height": film + drop, "pressure": rho * speed ** 2,
+              "milk": film + drop}[mode]
+        return cls(mode, 0.0, hi)
+
+
+def colour_map(t: np.ndarray) -> np.ndarray:
+    """The colour map at t in [0, 1] (clipped), numpy; the kernel does the same."""
+    t = np.clip(np.asarray(t, float), 0.0, 1.0) * (len(COLOUR_MAP) - 1)
+    i = np.minimum(t.astype(int), len(COLOUR_MAP) - 2)
+    f = (t - i)[..., None]
+    return COLOUR_MAP[i] * (1 - f) + COLOUR_MAP[i + 1] * f
+
+
+__all__ = ["MODES", "DEFAULT_MODE", "COLOUR_MAP", "MILK_LOW", "MILK_HIGH", "ColourScale",
+           "colour_map"]

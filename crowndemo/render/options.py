@@ -1,0 +1,92 @@
+"""The rendering options of the commands that record (``add_render_options``) and the frame
+sink built from them (``sink_from_args``), so that plugging rendering into a command is two
+lines."""
+from __future__ import annotations
+
+import argparse
+import os
+from typing import Tuple
+
+from .captions import LANGS
+from .colours import DEFAULT_MODE, MODES
+from .renderer import BOOTH_RESOLUTION, DEFAULT_RESOLUTION
+from .view import RenderSettings
+
+ORBIT_DEFAULT = 1.0          # degrees per frame when --orbit is given without a value
+
+
+def parse_resolution(text: str) -> Tuple[int, int]:
+    """'1280x720' -> (1280, 720)."""
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not WIDTHxHEIGHT, e.g. 1280x720") from None
+    if not (16 <= w <= 7680 and 16 <= h <= 4320):
+        raise argparse.ArgumentTypeError(f"{text!r}: width and height must be 16..7680 and "
+                                         "16..4320 pixels")
+    return w, h
+
+
+def positive(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
+    return value
+
+
+def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
+                       recording: bool = True) -> None:
+    """--colour, --lang, --resolution/--booth, --orbit and (``recording``) --fps, --no-video
+    and --no-render. ``lang=False`` leaves --lang to a command that already has it."""
+    g = parser.add_argument_group("rendering options")
+    g.add_argument("--colour", "--color", dest="colour", choices=MODES, default=DEFAULT_MODE,
+                   help=f"what the particle colour shows; milk is a white look (default: "
+                        f"{DEFAULT_MODE})")
+    if lang:
+        g.add_argument("--lang", choices=LANGS, default="en",
+                       help="caption language; ja needs a CJK font (default: en)")
+    size = g.add_mutually_exclusive_group()
+    size.add_argument("--resolution", type=parse_resolution, default=DEFAULT_RESOLUTION,
+                      metavar="WxH", help="image size in pixels (default: %dx%d)"
+                      % DEFAULT_RESOLUTION)
+    size.add_argument("--booth", dest="resolution", action="store_const",
+                      const=BOOTH_RESOLUTION, help="booth size, %dx%d" % BOOTH_RESOLUTION)
+    g.add_argument("--orbit", type=float, nargs="?", const=ORBIT_DEFAULT, default=0.0,
+                   metavar="DEG", help=f"turn the camera DEG degrees per frame about the "
+                   f"drop's axis (default: fixed; --orbit alone: {ORBIT_DEFAULT:g})")
+    if recording:
+        g.add_argument("--fps", type=positive, default=RenderSettings.fps,
+                       help=f"frames per second of the video (default: "
+                            f"{RenderSettings.fps:g})")
+        g.add_argument("--no-video", dest="video", action="store_false",
+                       help="write the PNG frames only, no video.mp4 or preview.gif")
+        g.add_argument("--no-render", dest="render", action="store_false",
+                       help="render nothing (no frames, no video; needs no Vulkan)")
+
+
+def settings_from_args(args) -> RenderSettings:
+    fps = getattr(args, "fps", RenderSettings.fps)
+    return RenderSettings(colour=args.colour, lang=getattr(args, "lang", "en") or "en",
+                          resolution=tuple(args.resolution), orbit=args.orbit,
+                          video=getattr(args, "video", True), fps=fps)
+
+
+def sink_from_args(args, resolved, out_dir: str, resume: bool = False):
+    """The FrameSink for a recording of ``resolved`` into ``out_dir`` (frames in
+    ``out_dir/frames``), or None with --no-render. Checks Vulkan first: a RenderError (with how
+    to install a driver) comes before any simulation time is spent."""
+    if not getattr(args, "render", True):
+        return None
+    from .sink import FrameSink
+    from .view import PresetView
+    from .window import check_available
+    check_available()
+    return FrameSink(os.fspath(out_dir), PresetView.from_resolved(resolved,
+                                                                  settings_from_args(args)),
+                     resume=resume)
+
+
+__all__ = ["add_render_options", "settings_from_args", "sink_from_args", "parse_resolution"]

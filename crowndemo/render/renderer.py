@@ -1,0 +1,94 @@
+"""The GGUI renderer: one window (offscreen unless shown), particles as lit spheres with
+per-vertex colours, an optional floor mesh, and a capture of each frame as an RGB image."""
+from __future__ import annotations
+
+import math
+from typing import Optional, Tuple
+
+import numpy as np
+
+from .buffers import ParticleBuffers
+from .camera import Pose
+from .colours import ColourScale
+from .floor import FloorMesh
+from .window import close_window, open_window
+
+BACKGROUND = (0.07, 0.08, 0.10)
+AMBIENT = (0.35, 0.35, 0.35)
+LIGHT = (0.75, 0.75, 0.75)
+DEFAULT_RESOLUTION = (1280, 720)
+BOOTH_RESOLUTION = (1920, 1080)
+
+
+class Renderer:
+    """Draws a ParticleState. Call ``render`` once per frame: each capture re-submits the
+    scene (GGUI keeps one frame per submission)."""
+
+    def __init__(self, resolution: Tuple[int, int] = DEFAULT_RESOLUTION, show: bool = False,
+                 title: str = "crowndemo", background=BACKGROUND):
+        import taichi as ti
+        self.resolution = (int(resolution[0]), int(resolution[1]))
+        self.window = open_window(title, self.resolution, show=show)
+        self.canvas = self.window.get_canvas()
+        self.scene = self.window.get_scene()
+        self.camera = ti.ui.Camera()
+        self.background = tuple(background)
+        self.buffers: Optional[ParticleBuffers] = None
+        self.drawn = 0                       # particles drawn in the last frame
+
+    def _buffers_for(self, capacity: int) -> ParticleBuffers:
+        if self.buffers is None or self.buffers.capacity < capacity:
+            self.buffers = ParticleBuffers(capacity)
+        return self.buffers
+
+    def draw(self, state, pose: Pose, scale: ColourScale, radius: float,
+             floor: Optional[FloorMesh] = None) -> None:
+        """Submit one frame: the fluid of ``state`` as spheres of world ``radius``."""
+        cam, scene = self.camera, self.scene
+        cam.position(*pose.eye)
+        cam.lookat(*pose.target)
+        cam.up(*pose.up)
+        cam.fov(pose.fov)
+        dist = math.dist(pose.eye, pose.target)
+        cam.z_near(dist * 1e-3)
+        cam.z_far(dist * 1e2)
+        scene.set_camera(cam)
+        scene.ambient_light(AMBIENT)
+        eye, target = np.array(pose.eye), np.array(pose.target)
+        scene.point_light(tuple(eye + np.array([0.0, 0.0, 0.8 * dist])
+                                + 0.3 * (eye - target)), LIGHT)
+        if floor is not None:
+            floor.draw(scene)
+        buf = self._buffers_for(state.capacity)
+        self.drawn = buf.fill(state, scale)
+        if self.drawn:
+            w, h = self.resolution
+            # GGUI 1.7.4 sizes a particle sprite by the window's width where a projection
+            # needs its height: scale the radius by h / w so spheres keep their world size
+            scene.particles(buf.pos, radius=radius * h / w, per_vertex_color=buf.colour,
+                            index_count=self.drawn)
+        self.canvas.set_background_color(self.background)
+        self.canvas.scene(scene)
+
+    def capture(self) -> np.ndarray:
+        """The submitted frame as an (height, width, 3) uint8 image, top row first."""
+        img = self.window.get_image_buffer_as_numpy()          # (w, h, 4), bottom row first
+        rgb = np.transpose(img[:, ::-1, :3], (1, 0, 2))
+        return (np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+
+    def render(self, state, pose: Pose, scale: ColourScale, radius: float,
+               floor: Optional[FloorMesh] = None) -> np.ndarray:
+        self.draw(state, pose, scale, radius, floor)
+        return self.capture()
+
+    def close(self) -> None:
+        close_window(self.window)
+
+    def __enter__(self) -> "Renderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+__all__ = ["Renderer", "BACKGROUND", "DEFAULT_RESOLUTION", "BOOTH_RESOLUTION"]

@@ -1,0 +1,104 @@
+"""The frame sink of a recording: each frame rendered to ``OUT/frames/frame_00000.png``, and
+when the recording closes, ``OUT/video.mp4`` and ``OUT/preview.gif``. A recording that did not
+complete gets ``video.partial.mp4`` and ``preview.partial.gif`` instead, so a partial video
+never stands as complete. Every file is written under a temporary name and renamed.
+
+It times itself: ``frame_seconds`` (render, caption and PNG of each frame), ``render_seconds``
+(their sum) and ``encode_seconds``, to set against the simulation's time per frame.
+"""
+from __future__ import annotations
+
+import glob
+import os
+import time as _time
+from typing import Dict, List, Optional
+
+from . import video
+from .renderer import Renderer
+from .view import PresetView
+
+COMPLETE = "complete"
+FRAME_NAME = "frame_{:05d}.png"
+
+
+def output_names(status: str) -> Dict[str, str]:
+    """The video and preview names for a recording that closed with ``status``."""
+    tag = "" if status == COMPLETE else ".partial"
+    return {"video": f"video{tag}.mp4", "preview": f"preview{tag}.gif"}
+
+
+class FrameSink:
+    def __init__(self, out_dir: str, view: PresetView, renderer: Optional[Renderer] = None,
+                 resume: bool = False):
+        """Frames go to ``out_dir/frames``; ``renderer`` (same resolution) is shared, not
+        closed by ``close``; without one the sink opens and closes its own. ``resume`` keeps
+        the frames of the interrupted recording that is being continued (the video is made
+        from every frame in the folder)."""
+        self.out_dir = out_dir
+        self.frames_dir = os.path.join(out_dir, "frames")
+        self.view = view
+        self.settings = view.settings
+        os.makedirs(self.frames_dir, exist_ok=True)
+        self._clear_stale(keep_frames=resume)
+        self._owns_renderer = renderer is None     # a renderer passed in stays open
+        self.renderer = renderer or Renderer(self.settings.resolution)
+        if self.renderer.resolution != tuple(self.settings.resolution):
+            raise ValueError(f"renderer of {self.renderer.resolution} for frames of "
+                             f"{self.settings.resolution}")
+        self.frame_seconds: List[float] = []
+        self.encode_seconds = 0.0
+        self.paths: List[str] = []
+        self.outputs: Dict[str, str] = {}          # what close() wrote: video, preview
+        self.status: Optional[str] = None
+
+    def _clear_stale(self, keep_frames: bool = False) -> None:
+        """Frames and videos of an earlier recording in the same folder would mix with ours
+        (a resumed recording keeps its frames: they are its own)."""
+        old = [] if keep_frames else glob.glob(os.path.join(self.frames_dir, "frame_*.png"))
+        old += [p for pattern in ("video*.mp4", "preview*.gif")
+                for p in glob.glob(os.path.join(self.out_dir, pattern))]
+        for p in old:
+            os.remove(p)
+
+    @property
+    def render_seconds(self) -> float:
+        return sum(self.frame_seconds)
+
+    def frame(self, sim, index: int, time: float) -> None:
+        """Render ``sim``'s particles at simulated ``time`` as frame ``index``."""
+        if self.status is not None:
+            raise RuntimeError("the frame sink is closed")
+        start = _time.perf_counter()
+        image = self.view.image(self.renderer, sim.state, time, index)
+        path = os.path.join(self.frames_dir, FRAME_NAME.format(index))
+        video.write_png(image, path)
+        self.paths.append(path)
+        self.frame_seconds.append(_time.perf_counter() - start)
+
+    def close(self, status: str) -> None:
+        """Release the window; encode the video and preview (named by ``status``)."""
+        if self.status is not None:
+            return
+        self.status = status
+        if self._owns_renderer:
+            self.renderer.close()
+        paths = sorted(glob.glob(os.path.join(self.frames_dir, "frame_*.png")))
+        if not (self.settings.video and paths):
+            return
+        start = _time.perf_counter()
+        names = output_names(status)
+        mp4 = os.path.join(self.out_dir, names["video"])
+        video.encode_mp4((video.read_image(p) for p in paths), mp4, self.settings.fps)
+        gif = os.path.join(self.out_dir, names["preview"])
+        video.encode_gif(paths, gif, self.settings.fps)
+        self.outputs = {"video": mp4, "preview": gif}
+        self.encode_seconds = _time.perf_counter() - start
+
+    def timing(self) -> Dict[str, float]:
+        n = len(self.frame_seconds)
+        return {"frames": n, "render_seconds": self.render_seconds,
+                "render_seconds_per_frame": self.render_seconds / n if n else 0.0,
+                "encode_seconds": self.encode_seconds}
+
+
+__all__ = ["FrameSink", "COMPLETE", "FRAME_NAME", "output_names"]

@@ -1,0 +1,235 @@
+"""The reference cases of the validation (method.md §7): each builds its scene at a spacing l0
+and measures one figure against its published or exact value.
+
+A case's ``run(l0, numerics)`` returns the measured figure, the reference and the relative
+error; the runner (``runner.py``) times it and varies the resolution and the settings.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Callable, Dict, List, Optional, Tuple
+
+import numpy as np
+
+from ..core import FLUID, Numerics, simulator_for
+from ..scenes import dam_break, hydrostatic_tank
+from ..scenes.crown import crown_base_radius
+from ..scenes.drop import oscillating_drop, resting_drop
+from . import oscillation
+from .observables import mechanical_pressure, surge_front
+from .crown_metrics import measure as crown_measure
+
+G, RHO = 9.81, 998.0
+
+# Martin & Moyce (1952), column a x 2a: (T = t sqrt(2 g / a), Z = front / a), method.md §7
+MARTIN_MOYCE = ((0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.345, 4.134),
+                (4.034, 4.944), (4.418, 5.881), (5.091, 6.980), (5.685, 7.945), (6.306, 8.966),
+                (6.822, 9.986))
+
+
+@dataclass
+class Outcome:
+    measured: float
+    reference: float
+    error: float                   # relative: |measured / reference - 1| (or as the case says)
+    sim: object                    # the simulator, for steps, particles and health
+    extra: Dict[str, float] = field(default_factory=dict)
+
+
+@dataclass
+class Case:
+    name: str
+    dim: int
+    quantity: str                  # what is measured, with its unit
+    reference: str                 # where the reference comes from
+    resolution: str                # how the spacing is given, e.g. "a/l0"
+    scales: Tuple[float, ...]      # resolution values, coarse to fine (full suite)
+    quick: Tuple[float, ...]       # the subset for `--quick` and the tests
+    l0_of: Callable[[float], float]
+    run: Callable[[float, Numerics], Outcome]
+    variants: Tuple[str, ...] = ("f64", "safety/2", "gradient=sum", "gradient=seed")
+
+
+# ---- hydrostatic pressure ------------------------------------------------------------------
+def fluid_pressure_profile(sim, width: float, depth: float, l0: float) -> Tuple[float, float]:
+    """Least-squares P = P0 - k z over fluid particles 3 l0 away from the walls and 4 l0 below
+    the free surface (the surface layer is held at P = 0 by M3); returns (k, P0)."""
+    sim.refresh_pressure()
+    s = sim.snapshot()
+    p, P, kind = s["pos"], s["pressure"], s["kind"]
+    inner = (kind == FLUID) & np.all((p[:, :-1] > 3 * l0) & (p[:, :-1] < width - 3 * l0), axis=1)
+    inner &= (p[:, -1] > 3 * l0) & (p[:, -1] < depth - 4 * l0)
+    slope, p0 = np.polyfit(p[inner, -1], P[inner], 1)
+    return -float(slope), float(p0)
+
+
+def _hydrostatic(dim: int) -> Case:
+    width, depth = (0.04, 0.04) if dim == 2 else (0.036, 0.06)
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        # nu = 1e-3 m^2/s damps the start-up waves (the tank starts at zero pressure); the
+        # hydrostatic answer does not depend on it
+        scene = hydrostatic_tank(dim=dim, l0=l0, width=width, depth=depth, nu=1.0e-3,
+                                 numerics=numerics)
+        sim = simulator_for(scene)
+        sim.run(0.25)
+        k, p0 = fluid_pressure_profile(sim, width, depth, l0)
+        ref = RHO * G * depth
+        return Outcome(p0, ref, abs(p0 / ref - 1), sim, {"slope_over_rho_g": k / (RHO * G)})
+
+    return Case(f"hydrostatic-{dim}d", dim, "floor pressure P(0) [Pa] from the fluid profile",
+                "rho g H (method.md §7)", "H/l0",
+                (20, 40, 80) if dim == 2 else (20, 30, 40), (20, 40) if dim == 2 else (20,),
+                lambda s: depth / s, run)
+
+
+# ---- dam break -----------------------------------------------------------------------------
+def _dam_break(dim: int) -> Case:
+    a = 0.05 if dim == 2 else 0.03
+    points = [(T, Z) for T, Z in MARTIN_MOYCE if T <= 3.0]
+
+    def _front(sim) -> float:     # the leading edge of the connected liquid body
+        snap = sim.snapshot()
+        return surge_front(snap["pos"][snap["kind"] == FLUID], sim.physics.l0)
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        scene = dam_break(dim=dim, a=a, l0=l0, numerics=numerics)
+        sim = simulator_for(scene)
+        scale = math.sqrt(2 * G / a)
+        front: List[float] = []
+        sim.run(points[-1][0] / scale, frame_times=[T / scale for T, _ in points],
+                on_frame=lambda s, i: front.append(_front(s) / a))
+        ratios = np.array(front) / np.array([Z for _, Z in points])
+        worst = int(np.argmax(np.abs(ratios - 1)))
+        return Outcome(front[worst], points[worst][1], float(abs(ratios[worst] - 1)), sim,
+                       {f"Z/Z_ref at T={T:g}": float(r) for (T, _), r in zip(points, ratios)})
+
+    return Case(f"dam-break-{dim}d", dim, "surge front Z = z/a, worst point for T <= 3",
+                "Martin & Moyce 1952 (method.md §7)", "a/l0",
+                (12.5, 25, 50) if dim == 2 else (8, 12, 16), (12.5, 25) if dim == 2 else (8,),
+                lambda s: a / s, run)
+
+
+# ---- drop oscillation ------------------------------------------------------------------------
+def _oscillation(dim: int) -> Case:
+    R, nu, periods = 1.0e-3, 1.0e-5, 3.0
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        scene = oscillating_drop(dim=dim, radius=R, l0=l0, nu=nu, periods=periods,
+                                 numerics=numerics)
+        sim = simulator_for(scene)
+        ts, ss = [], []
+
+        def sample(s, i):
+            ts.append(s.stats.time)
+            ss.append(oscillation.deformation(s.snapshot()["pos"]))
+        sim.run(scene.t_end, frame_times=np.linspace(0, scene.t_end, int(40 * periods) + 1),
+                on_frame=sample)
+        omega, decay = oscillation.fit(ts, ss)
+        ref, ref_decay = scene.info["omega_rad_s"], scene.info["decay_1_s"]
+        err = abs(omega / ref - 1) if math.isfinite(omega) else math.inf
+        return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay})
+
+    return Case(f"drop-oscillation-{dim}d", dim, "mode-2 angular frequency [rad/s]",
+                "Rayleigh-Lamb (method.md §7)", "R/l0",
+                (8, 12, 16) if dim == 2 else (5, 6, 8), (8, 12) if dim == 2 else (5,),
+                lambda s: R / s, run)
+
+
+# ---- Laplace pressure ------------------------------------------------------------------------
+def _laplace(dim: int) -> Case:
+    R = 1.0e-3
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        # the virial pressure needs pair forces: the 'sum' gradient form (observables.py)
+        numerics = replace(numerics, pressure_gradient="sum")
+        scene = resting_drop(dim=dim, radius=R, l0=l0, nu=1.0e-4, t_end=0.02,
+                             numerics=numerics)
+        sim = simulator_for(scene)
+        virial: List[float] = []
+        eos: List[float] = []
+        lat, ph = sim.lattice, sim.physics
+
+        def sample(s, i):
+            snap = s.snapshot()
+            p = snap["pos"].astype(float)
+            inner = np.linalg.norm(p - p.mean(axis=0), axis=1) < 0.5 * R
+            dt = min(s.numerics.acoustic * l0 / ph.c, s.numerics.capillary * math.sqrt(
+                ph.rho * l0 ** 3 / (2 * math.pi * ph.sigma)))
+            mech = mechanical_pressure(p, l0, lat.re, lat.n0, ph.rho, lat.C, lat.mass,
+                                       ph.c ** 2, s.numerics.free_surface_beta(dim), dt)
+            virial.append(float(mech[inner].mean()))
+            s.refresh_pressure()
+            eos.append(float(s.snapshot()["pressure"][inner].mean()))
+        sim.run(scene.t_end, frame_times=np.linspace(0.5 * scene.t_end, scene.t_end, 6),
+                on_frame=sample)
+        ref = (dim - 1) * ph.sigma / R
+        p_in = float(np.mean(virial))
+        return Outcome(p_in, ref, abs(p_in / ref - 1), sim,
+                       {"eos_pressure_Pa": float(np.mean(eos))})
+
+    return Case(f"laplace-{dim}d", dim, "virial pressure inside a resting drop (r < R/2) [Pa]",
+                "sigma/R (2D), 2 sigma/R (3D) (method.md §7)", "R/l0",
+                (8, 11, 16) if dim == 2 else (4, 5, 6), (8,) if dim == 2 else (4,),
+                lambda s: R / s, run, variants=("f64", "safety/2"))
+
+
+# ---- crown base radius -----------------------------------------------------------------------
+def crown_case(preset: str = "quick", t_end: Optional[float] = None,
+               refine: Tuple[float, ...] = (1.0, 0.8, 0.6)) -> Case:
+    """The crown base radius of a 3D crown preset against Yarin & Weiss's sqrt(t) law, over the
+    frames after the crown has formed (tau = t U / D > 0.25 after contact)."""
+    from .. import config
+
+    base = config.load(preset, "draft")
+
+    def run(l0: float, numerics: Numerics, trim: bool = True) -> Outcome:
+        kw = base.crown_kwargs()
+        kw.update(l0=l0, numerics=numerics, trim=trim)
+        if t_end is not None:
+            kw["t_end"] = t_end
+        from ..scenes import crown
+        scene = crown(**kw)
+        sim = simulator_for(scene)
+        U, D, h, gap = kw["speed"], kw["drop"], kw["film"], kw["gap"]
+        t_contact = gap / U
+        frames = np.linspace(0, kw["t_end"], 9)[1:]
+        ratios: List[float] = []
+
+        def sample(s, i):
+            t = s.stats.time - t_contact
+            if t * U / D <= 0.25:
+                return
+            snap = s.snapshot()
+            m = crown_measure(snap["pos"][snap["kind"] == FLUID], s.stats.time, h, D, l0)
+            ratios.append(m.base_radius / crown_base_radius(t, U, D, h))
+        sim.run(kw["t_end"], frame_times=frames, on_frame=sample)
+        r = float(np.mean(ratios)) if ratios else math.nan
+        return Outcome(r, 1.0, abs(r - 1), sim, {"frames": len(ratios)})
+
+    l0 = base.l0      # the draft's spacing: the coarsest that keeps 3 particles across the film
+    return Case(f"crown-base-{preset}", 3, "crown base radius / Yarin-Weiss, mean over frames",
+                "Yarin & Weiss 1995 (method.md §7)", "D/l0",
+                tuple(round(base.scene["drop"] / (f * l0), 2) for f in refine),
+                (round(base.scene["drop"] / l0, 2),),
+                lambda s: base.scene["drop"] / s, run,
+                variants=("untrimmed", "safety/2", "gradient=sum"))
+
+
+def all_cases(full: bool = True) -> Dict[str, Case]:
+    cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace)
+             for d in (2, 3)]
+    cases.append(crown_case("quick"))
+    if full:
+        cases.append(crown_case("3m-drop", refine=(1.0, 0.85, 0.7)))
+    return {c.name: c for c in cases}
+
+
+def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
+    """The Numerics of a settings variant (precision and trimming are handled by the runner)."""
+    if variant == "safety/2":
+        return replace(numerics, courant=numerics.courant / 2, acoustic=numerics.acoustic / 2)
+    if variant.startswith("gradient="):
+        return replace(numerics, pressure_gradient=variant.split("=", 1)[1])
+    return numerics

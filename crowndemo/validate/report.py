@@ -1,0 +1,108 @@
+"""Validation output: a Markdown table, a CSV file and a log-log plot of error against wall time
+per case (matplotlib, an optional extra: without it the plot is skipped and said so)."""
+from __future__ import annotations
+
+import csv
+import math
+import os
+from typing import Dict, Iterable, List, Optional, Sequence
+
+COLUMNS = ("case", "variant", "resolution", "scale", "l0", "particles", "steps", "wall_s",
+           "compile_s", "measured", "reference", "error", "outcome")
+
+
+def _fmt(v) -> str:
+    if isinstance(v, float):
+        if not math.isfinite(v):
+            return str(v)
+        return f"{v:.4g}"
+    return str(v)
+
+
+def markdown(rows: Sequence, title: str = "Validation") -> str:
+    """One table per case: a row per run, the error in per cent."""
+    out: List[str] = []
+    by_case: Dict[str, list] = {}
+    for r in rows:
+        by_case.setdefault(r.case, []).append(r)
+    for name, rs in by_case.items():
+        out.append(f"### {name}: {rs[0].quantity}")
+        out.append("")
+        out.append("| variant | resolution | l0 (m) | particles | steps | wall (s) | compile (s) "
+                   "| measured | reference | error | outcome |")
+        out.append("|---|---|---|---|---|---|---|---|---|---|---|")
+        for r in rs:
+            err = f"{100 * r.error:.2f} %" if math.isfinite(r.error) else "-"
+            out.append(f"| {r.variant} | {r.resolution} = {r.scale:g} | {r.l0:.3g} | "
+                       f"{r.particles:,} | {r.steps:,} | {r.wall_s:.1f} | {r.compile_s:.1f} | "
+                       f"{_fmt(r.measured)} | {_fmt(r.reference)} | {err} | {r.outcome} |")
+        out.append("")
+    return "\n".join(out)
+
+
+def write_csv(rows: Sequence, path: str) -> None:
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(COLUMNS + ("extra",))
+        for r in rows:
+            d = r.as_dict()
+            w.writerow([d[k] for k in COLUMNS] +
+                       ["; ".join(f"{k}={_fmt(v)}" for k, v in d["extra"].items())])
+
+
+def plot(rows: Sequence, path: str) -> Optional[str]:
+    """Error against wall time, log-log, one line per case through its base-setting runs and
+    a marker per variant. Returns None when written, else why not."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return "matplotlib is not installed (pip install '.[plot]')"
+    fig, ax = plt.subplots(figsize=(8, 5.5))
+    cases: Dict[str, list] = {}
+    for r in rows:
+        if r.outcome == "ok" and math.isfinite(r.error) and r.error > 0:
+            cases.setdefault(r.case, []).append(r)
+    markers = {"f64": "s", "safety/2": "^", "gradient=sum": "D", "gradient=seed": "v",
+               "untrimmed": "P"}
+    for i, (name, rs) in enumerate(sorted(cases.items())):
+        colour = f"C{i % 10}"
+        base = sorted((r for r in rs if r.variant == "base"), key=lambda r: r.wall_s)
+        if base:
+            ax.plot([r.wall_s for r in base], [r.error for r in base], "o-", color=colour,
+                    label=name)
+        for r in rs:
+            if r.variant != "base":
+                ax.plot(r.wall_s, r.error, markers.get(r.variant, "x"), color=colour,
+                        markerfacecolor="none")
+    for v, m in markers.items():
+        ax.plot([], [], m, color="grey", markerfacecolor="none", label=v)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("wall time without JIT compile (s)")
+    ax.set_ylabel("relative error")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7, ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return None
+
+
+def write_all(rows: Sequence, folder: str, header: Iterable[str] = ()) -> Dict[str, str]:
+    """validation.md, validation.csv and error_vs_time.png in ``folder``; returns the paths
+    (and 'plot_skipped' with the reason when there is no plot)."""
+    os.makedirs(folder, exist_ok=True)
+    md = os.path.join(folder, "validation.md")
+    with open(md, "w") as f:
+        f.write("\n".join(list(header) + ["", markdown(rows)]))
+    out = {"markdown": md, "csv": os.path.join(folder, "validation.csv")}
+    write_csv(rows, out["csv"])
+    png = os.path.join(folder, "error_vs_time.png")
+    why = plot(rows, png)
+    if why is None:
+        out["plot"] = png
+    else:
+        out["plot_skipped"] = why
+    return out

@@ -1,0 +1,87 @@
+"""Runs validation cases at several resolutions and settings and collects one row per run:
+error, wall time, particles, steps (method.md §8)."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass, field
+from typing import Callable, Dict, Iterable, List, Optional
+
+from .. import backend
+from ..core import InstabilityError, Numerics
+from .cases import Case, variant_numerics
+
+
+@dataclass
+class Row:
+    case: str
+    dim: int
+    variant: str                  # "base", "f64", "safety/2", "gradient=sum", "untrimmed", ...
+    resolution: str               # e.g. "a/l0"
+    scale: float                  # its value
+    l0: float
+    particles: int
+    steps: int
+    wall_s: float                 # set-up + stepping, first step (JIT compile) excluded
+    compile_s: float              # the first step, which compiles the kernels
+    measured: float
+    reference: float
+    error: float
+    outcome: str                  # "ok" or "unstable: ..." / "failed: ..."
+    quantity: str = ""
+    extra: Dict[str, float] = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def run_one(case: Case, scale: float, variant: str = "base") -> Row:
+    """One case at one resolution and one settings variant (the backend's precision must
+    already be the variant's)."""
+    l0 = case.l0_of(scale)
+    numerics = variant_numerics(variant, Numerics())
+    opts = {"trim": False} if variant == "untrimmed" else {}
+    t0 = time.perf_counter()
+    try:
+        res = case.run(l0, numerics, **opts)
+    except InstabilityError as e:
+        return Row(case.name, case.dim, variant, case.resolution, scale, l0, 0, e.step,
+                   time.perf_counter() - t0, 0.0, math.nan, math.nan, math.inf,
+                   f"unstable: {e.what} at step {e.step}, t = {e.time * 1e3:.4g} ms",
+                   case.quantity)
+    wall = time.perf_counter() - t0
+    sim = res.sim
+    compile_s = sim.stats.first_step_seconds
+    return Row(case.name, case.dim, variant, case.resolution, scale, l0, int(sim.state.count),
+               sim.stats.steps, wall - compile_s, compile_s, res.measured, res.reference,
+               res.error, "ok", case.quantity, dict(res.extra))
+
+
+def plan(case: Case, quick: bool, variants: bool) -> List[tuple]:
+    """(scale, variant) pairs: every resolution in the base settings, and each variant at the
+    middle resolution (the finest of a quick plan)."""
+    scales = case.quick if quick else case.scales
+    out = [(s, "base") for s in scales]
+    if variants:
+        mid = scales[len(scales) // 2] if not quick else scales[-1]
+        out += [(mid, v) for v in case.variants]
+    return out
+
+
+def run_suite(cases: Iterable[Case], quick: bool = False, variants: bool = True,
+              on_row: Optional[Callable[[Row], None]] = None) -> List[Row]:
+    """Every case's plan; the f64 runs last, after one switch of the backend's precision."""
+    be = backend.current()
+    jobs = [(c, s, v) for c in cases for s, v in plan(c, quick, variants)]
+    jobs.sort(key=lambda j: j[2] == "f64")
+    rows: List[Row] = []
+    for case, scale, variant in jobs:
+        if variant == "f64" and backend.current().precision != "f64":
+            backend.init(be.arch, "f64", be.seed, be.single_thread)
+        row = run_one(case, scale, variant)
+        rows.append(row)
+        if on_row:
+            on_row(row)
+    if backend.current().precision != be.precision:
+        backend.init(be.arch, be.precision, be.seed, be.single_thread)
+    return rows

@@ -1,0 +1,98 @@
+"""The regime map: crown or no crown over film thickness and impact speed, with Cossali et al.'s
+splash threshold drawn on it (method.md §7). One compiled simulator serves every point
+(control.Session), each point is a preset with ``scene.film`` and ``scene.speed`` set."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+from typing import Callable, List, Optional, Sequence
+
+from .. import config
+from ..control import Session
+from .verdicts import run_and_measure, threshold_speed
+
+
+@dataclass
+class Point:
+    film: float
+    speed: float
+    crown: Optional[bool]        # None when the run stopped before its end
+    rim_height: float
+    base_radius: float
+    steps: int
+    wall_s: float
+    outcome: str
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def run(preset: str, films: Sequence[float], speeds: Sequence[float], quality: str = "draft",
+        sets: Sequence[str] = (), on_point: Optional[Callable[[Point], None]] = None
+        ) -> List[Point]:
+    """Every (film, speed) pair; each is checked through the preset's validation first."""
+    resolved = [config.load(preset, quality, list(sets) + [f"scene.film={h!r}",
+                                                           f"scene.speed={u!r}"])
+                for h in films for u in speeds]
+    session = Session()
+    points = []
+    for r in resolved:
+        t0 = time.perf_counter()
+        sim = session.load(r.build_scene())
+        m, outcome = run_and_measure(sim, r)
+        p = Point(r.scene["film"], r.speed, m.crown if outcome == "ran to the end" else None,
+                  m.rim_height, m.base_radius, sim.stats.steps, time.perf_counter() - t0,
+                  outcome)
+        points.append(p)
+        if on_point:
+            on_point(p)
+    return points
+
+
+def plot(points: List[Point], drop: float, liquid: dict, path: str, title: str) -> Optional[str]:
+    """The map as a PNG; None when written, else why not (matplotlib is an optional extra)."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return "matplotlib is not installed (pip install '.[plot]')"
+    fig, ax = plt.subplots(figsize=(7, 5))
+    style = {True: ("o", "C3", "crown"), False: ("s", "C0", "no crown"),
+             None: ("x", "grey", "stopped early")}
+    for key, (m, col, lab) in style.items():
+        sel = [p for p in points if p.crown is key]
+        if sel:
+            ax.plot([p.film * 1e3 for p in sel], [p.speed for p in sel], m, color=col,
+                    markersize=9, label=lab, linestyle="none")
+    hs = sorted({p.film for p in points})
+    h_lo, h_hi = hs[0] * 0.8, hs[-1] * 1.2
+    grid = [h_lo + (h_hi - h_lo) * k / 100 for k in range(101)]
+    ax.plot([h * 1e3 for h in grid],
+            [threshold_speed(drop, h, liquid["rho"], liquid["nu"], liquid["sigma"]) for h in grid],
+            "k--", label="Cossali et al. 1997: K = 2100 + 5880 (h/D)^1.44")
+    ax.set_xlabel("film thickness h (mm)")
+    ax.set_ylabel("impact speed U (m/s)")
+    ax.set_title(title, fontsize=9)
+    ax.set_ylim(bottom=0)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return None
+
+
+def markdown(points: List[Point], drop: float, liquid: dict) -> str:
+    out = ["| h (mm) | U (m/s) | simulated | rim height (mm) | base radius (mm) | Cossali "
+           "threshold U (m/s) | steps | wall (s) | outcome |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for p in points:
+        u_th = threshold_speed(drop, p.film, liquid["rho"], liquid["nu"], liquid["sigma"])
+        verdict = {True: "crown", False: "no crown", None: "-"}[p.crown]
+        base = f"{p.base_radius * 1e3:.3g}" if math.isfinite(p.base_radius) else "-"
+        out.append(f"| {p.film * 1e3:.3g} | {p.speed:.3g} | {verdict} | "
+                   f"{p.rim_height * 1e3:.3g} | {base} | {u_th:.3g} | {p.steps:,} | "
+                   f"{p.wall_s:.1f} | {p.outcome} |")
+    return "\n".join(out)

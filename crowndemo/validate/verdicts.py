@@ -1,0 +1,114 @@
+"""The seed's four observations (method.md §6) reproduced from the presets: crown at 8 and
+7 m/s on a 1 mm film, none at 2 m/s, none on a 10 mm layer at 5 m/s; each with its crown
+metrics at the end time and Cossali et al.'s splash number K against its threshold (§7)."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import asdict, dataclass
+from typing import Callable, Iterable, List, Optional, Tuple
+
+from .. import config
+from ..core import FLUID, InstabilityError, simulator_for
+from .crown_metrics import CrownMetrics, measure
+
+# preset -> what the seed saw
+SEED = {"3m-drop": True, "2.5m-drop": True, "20cm-drop": False, "thick-layer": False}
+
+
+def cossali(U: float, D: float, h: float, rho: float, nu: float, sigma: float) -> dict:
+    """K = We Oh^-0.4 against 2100 + 5880 delta^1.44 (Cossali et al. 1997, method.md §7)."""
+    we = rho * U * U * D / sigma
+    oh = rho * nu / math.sqrt(rho * sigma * D)
+    k = we * oh ** -0.4
+    threshold = 2100.0 + 5880.0 * (h / D) ** 1.44
+    return {"We": we, "Oh": oh, "K": k, "K_threshold": threshold, "splash": k > threshold}
+
+
+def threshold_speed(D: float, h: float, rho: float, nu: float, sigma: float) -> float:
+    """The impact speed at which K reaches Cossali's threshold for a film h (m/s)."""
+    oh = rho * nu / math.sqrt(rho * sigma * D)
+    k_th = 2100.0 + 5880.0 * (h / D) ** 1.44
+    return math.sqrt(k_th * oh ** 0.4 * sigma / (rho * D))
+
+
+@dataclass
+class Verdict:
+    preset: str
+    quality: str
+    l0: float
+    speed: float
+    film: float
+    drop: float
+    t_end: float
+    particles: int
+    steps: int
+    wall_s: float
+    metrics: Optional[dict]
+    crown: Optional[bool]
+    seed_crown: Optional[bool]
+    agrees: Optional[bool]
+    cossali: dict
+    outcome: str
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def run_and_measure(sim, resolved) -> Tuple[CrownMetrics, str]:
+    """Run a loaded simulator to the preset's end time (or until it goes unstable) and measure
+    the crown at the last time reached; returns the metrics and the outcome."""
+    outcome = "ran to the end"
+    try:
+        sim.run(resolved.t_end)
+    except InstabilityError as e:
+        outcome = f"stopped: {e.what} at t = {e.time * 1e3:.4g} ms"
+    snap = sim.snapshot()
+    s = resolved.scene
+    return measure(snap["pos"][snap["kind"] == FLUID], sim.stats.time, s["film"], s["drop"],
+                   resolved.l0), outcome
+
+
+def run_preset(preset: str, quality: str = "draft", sets: Iterable[str] = ()) -> Verdict:
+    r = config.load(preset, quality, list(sets))
+    s, liq = r.scene, r.liquid
+    t0 = time.perf_counter()
+    scene = r.build_scene()
+    sim = simulator_for(scene)
+    m, outcome = run_and_measure(sim, r)
+    seed = SEED.get(r.name)
+    return Verdict(r.name, quality, r.l0, r.speed, s["film"], s["drop"], r.t_end,
+                   int(len(scene.pos)), sim.stats.steps, time.perf_counter() - t0, m.as_dict(),
+                   m.crown, seed, None if seed is None else (m.crown == seed),
+                   cossali(r.speed, s["drop"], s["film"], liq["rho"], liq["nu"], liq["sigma"]),
+                   outcome)
+
+
+def run_all(presets: Iterable[str] = tuple(SEED), quality: str = "draft",
+            on_row: Optional[Callable[[Verdict], None]] = None) -> List[Verdict]:
+    rows = []
+    for p in presets:
+        v = run_preset(p, quality)
+        rows.append(v)
+        if on_row:
+            on_row(v)
+    return rows
+
+
+def markdown(rows: List[Verdict]) -> str:
+    out = ["| preset | U (m/s) | h (mm) | D/l0 | t (ms) | base r (mm) | rim h (mm) | jets | "
+           "droplets | verdict | the seed | Cossali K / threshold | wall (s) |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for v in rows:
+        m = v.metrics or {}
+        seed = {True: "crown", False: "no crown", None: "-"}[v.seed_crown]
+        mine = "crown" if v.crown else "no crown"
+        agree = "" if v.agrees is None else (" (agrees)" if v.agrees else " (DISAGREES)")
+        c = v.cossali
+        out.append(f"| {v.preset} | {v.speed:.3g} | {v.film * 1e3:.3g} | {v.drop / v.l0:.3g} | "
+                   f"{m.get('time', 0) * 1e3:.3g} | {m.get('base_radius', math.nan) * 1e3:.3g} | "
+                   f"{m.get('rim_height', math.nan) * 1e3:.3g} | {m.get('jets', 0)} | "
+                   f"{m.get('droplets', 0)} | {mine}{agree} | {seed} | "
+                   f"{c['K']:.3g} / {c['K_threshold']:.3g} "
+                   f"({'splash' if c['splash'] else 'no splash'}) | {v.wall_s:.0f} |")
+    return "\n".join(out)

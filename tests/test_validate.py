@@ -1,0 +1,121 @@
+"""The validation suite (issue 5): its measurements on signals and shapes with known answers,
+a quick subset of the reference cases with tolerances from physics, and a quick subset of the
+stability suite."""
+import math
+
+import numpy as np
+import pytest
+
+from crowndemo.cli import main
+from crowndemo.scenes.drop import mode2_omega, oscillating_drop
+from crowndemo.validate import cases, oscillation, stability, verdicts
+from crowndemo.validate.runner import plan, run_one
+
+
+# ---- measurements with exact answers ---------------------------------------------------------
+def test_fit_recovers_a_damped_oscillation():
+    t = np.linspace(0, 0.03, 400)
+    omega, decay = 661.6, 40.0
+    s = 3e-8 * np.exp(-decay * t) * np.sin(omega * t)
+    w, g = oscillation.fit(t, s)
+    assert w == pytest.approx(omega, rel=0.01)
+    assert g == pytest.approx(decay, rel=0.05)
+
+
+def test_deformation_of_an_ellipse():
+    # a uniform ellipse with semi-axes a, b: <x^2> - <y^2> = (a^2 - b^2) / 4
+    a, b, h = 1.2e-3, 0.8e-3, 1e-5
+    ax = np.arange(-a, a, h) + h / 2
+    x, y = np.meshgrid(ax, ax, indexing="ij")
+    inside = (x / a) ** 2 + (y / b) ** 2 <= 1
+    pts = np.stack([x[inside], y[inside]], axis=1)
+    assert oscillation.deformation(pts) == pytest.approx((a * a - b * b) / 4, rel=0.01)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_oscillating_drop_starts_in_mode_2(dim):
+    # the surface's radial speed is amplitude * omega * R * cos(2 theta) (P2(cos theta) in 3D)
+    R, amp = 1e-3, 0.1
+    sc = oscillating_drop(dim=dim, radius=R, l0=R / 10, amplitude=amp)
+    omega = mode2_omega(dim, R, 0.0728, 998.0)
+    assert sc.info["omega_rad_s"] == pytest.approx(math.sqrt((6 if dim == 2 else 8) * 0.0728
+                                                             / (998.0 * R ** 3)))
+    r = np.linalg.norm(sc.pos, axis=1)
+    vr = np.einsum("ij,ij->i", sc.vel, sc.pos) / r
+    cos = sc.pos[:, 0] / r if dim == 2 else sc.pos[:, 2] / r
+    shape = np.cos(2 * np.arccos(cos)) if dim == 2 else 0.5 * (3 * cos ** 2 - 1)
+    assert np.allclose(vr, amp * omega * r * shape, rtol=1e-9, atol=1e-12)
+
+
+def test_cossali_threshold_speed_is_where_k_meets_the_threshold():
+    D, h, rho, nu, sigma = 1e-2, 1e-3, 998.0, 1e-6, 0.0728
+    U = verdicts.threshold_speed(D, h, rho, nu, sigma)
+    c = verdicts.cossali(U, D, h, rho, nu, sigma)
+    assert c["K"] == pytest.approx(c["K_threshold"], rel=1e-12)
+    # method.md §7: the criterion predicts a splash for water even at 2 m/s
+    assert verdicts.cossali(2.0, D, h, rho, nu, sigma)["splash"]
+
+
+def test_plan_covers_resolutions_and_variants():
+    c = cases.all_cases(full=False)["dam-break-2d"]
+    p = plan(c, quick=False, variants=True)
+    assert [s for s, v in p if v == "base"] == list(c.scales)
+    assert {v for _, v in p} == {"base", *c.variants}
+
+
+# ---- quick reference cases --------------------------------------------------------------------
+def test_hydrostatic_case_within_5_percent():
+    c = cases.all_cases(full=False)["hydrostatic-2d"]
+    row = run_one(c, c.quick[0])
+    assert row.outcome == "ok"
+    assert row.error < 0.05                          # P(0) = rho g H within 5 % (issue 2)
+    assert row.particles > 0 and row.steps > 0 and row.wall_s > 0
+
+
+def test_dam_break_case_reports_worst_point():
+    c = cases.all_cases(full=False)["dam-break-2d"]
+    row = run_one(c, c.quick[0])
+    ratios = [v for k, v in row.extra.items() if k.startswith("Z/Z_ref")]
+    assert len(ratios) == 4
+    assert row.error == pytest.approx(max(abs(r - 1) for r in ratios))
+    # held at 20 % (the README's validation status: the front leads by 10-18 %)
+    assert row.error < 0.20
+
+
+# ---- quick stability subset ---------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def stability_rows():
+    names = ["fixed-dt-3x", "touching", "dry-floor", "thrown-out"]
+    return {r.case: r for r in stability.run_suite(names)}
+
+
+def test_fixed_dt_over_a_limit_is_refused_naming_it(stability_rows):
+    r = stability_rows["fixed-dt-3x"]
+    assert r.outcome.startswith("refused") and "acoustic" in r.outcome and r.steps == 0
+
+
+@pytest.mark.parametrize("name", ["touching", "dry-floor"])
+def test_extreme_impacts_run_to_the_end_healthy(stability_rows, name):
+    r = stability_rows[name]
+    assert r.outcome == "ran to the end", r.outcome
+    assert r.passed, r.checks
+    assert r.nonfinite == 0
+    assert r.energy_end_J <= r.energy_start_J * (1 + stability.ENERGY_GROWTH)   # no source
+    assert r.time_s == pytest.approx(r.t_end_s)
+
+
+def test_particles_thrown_out_are_counted(stability_rows):
+    r = stability_rows["thrown-out"]
+    assert r.passed, r.checks
+    assert sum(r.left_domain.values()) > 0
+    assert set(r.left_domain) <= {"x-", "x+", "y-", "y+"}
+
+
+def test_validate_cli_lists_and_rejects(capsys):
+    assert main(["validate", "--list"]) == 0
+    out = capsys.readouterr().out
+    for name in ("hydrostatic-2d", "dam-break-3d", "drop-oscillation-2d", "laplace-3d",
+                 "crown-base-quick", "stability", "verdicts"):
+        assert name in out
+    assert main(["validate", "no-such-case"]) == 2
+    assert "unknown case no-such-case" in capsys.readouterr().err
