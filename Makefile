@@ -28,7 +28,7 @@ vulkan:
 	fi
 
 demo: setup
-	$(VENV)/bin/crowndemo scene dam-break --dim 3 --t-end 0.05
+	$(VENV)/bin/crowndemo record 2m-drop
 
 test: setup
 	$(PY) -m pytest -q

@@ -330,7 +330,7 @@ def test_extends_chain(tmp_path):
 
 def test_set_overrides():
     base = config.load("3m-drop")
-    assert base.t_end == 1e-3 and base.where["t_end"][0] == "quality.draft.t_end"
+    assert base.t_end == 2e-3 and base.where["t_end"][0] == "quality.draft.t_end"
     r = config.load("3m-drop", "draft", [
         "scene.speed=5", "scene.t_end=5e-4", "numerics.courant=0.1",
         "quality.draft.l0=3e-4", "scene.liquid.sigma=0", "scene.sound_speed=30"])

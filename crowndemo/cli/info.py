@@ -230,6 +230,9 @@ def _info_preset(args) -> int:
     print(f"  numerics    gradient {n['pressure_gradient']}; safety courant {n['courant']:g}, "
           f"acoustic {n['acoustic']:g}, viscous {n['viscous']:g}, capillary {n['capillary']:g}; "
           f"beta {beta:g}")
+    print("              collision model: " + (
+        f"approaching pairs closer than {n['collision']:g} l0, restitution "
+        f"{n['restitution']:g}" if n["collision"] > 0 else "off"))
     print(f"              abort at density excess {n['max_density_excess']:g}, Mach "
           f"{n['max_mach']:g}, {n['max_out_fraction']:g} of the fluid out; dt_max "
           f"{n['dt_max'] if n['dt_max'] is not None else 'none'}, fixed dt "

@@ -125,8 +125,12 @@ def _record(args) -> int:
                                     session=session, checkpoint_every=args.checkpoint_every,
                                     fluid_only=not args.all_particles, max_steps=args.max_steps,
                                     on_step=progress, on_start=announce, stop=stop, backend=be)
-            except RecordError as e:
-                raise UsageError(str(e)) from None
+            except BaseException as e:
+                for sink in render:           # a run that never started: free the window
+                    sink.release()
+                if isinstance(e, RecordError):
+                    raise UsageError(str(e)) from None
+                raise
             meta = json.loads((folder / "metadata.json").read_text())
             if render:
                 meta = _add_render_timing(folder, meta, render[0], res)

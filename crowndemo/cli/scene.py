@@ -79,17 +79,13 @@ def _build_scene(name: str, args):
     return sc, val
 
 
-# Martin & Moyce (1952), column a x 2a: (T = t sqrt(2 g / a), Z = z / a), method.md §7
-MARTIN_MOYCE = ((0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.345, 4.134),
-                (4.034, 4.944), (4.418, 5.881), (5.091, 6.980), (5.685, 7.945), (6.306, 8.966),
-                (6.822, 9.986))
-
-
 def _observables(name: str, scene, sim) -> Dict:
     """One scene-specific figure against its reference (method.md §7), at the end time."""
     import numpy as np
 
     from ..core.state import FLUID
+    from ..validate.cases import MARTIN_MOYCE
+    from ..validate.observables import surge_front
     from ..scenes import circularity, equivalent_radius
 
     sim.refresh_pressure()
@@ -112,7 +108,7 @@ def _observables(name: str, scene, sim) -> Dict:
     if name == "dam-break":
         a = scene.info["a_m"]
         T = sim.stats.time * math.sqrt(2.0 * ph.gravity / a)
-        Z = float(pos[:, 0].max() + 0.5 * ph.l0) / a
+        Z = surge_front(pos, ph.l0) / a      # the leading edge of the connected liquid
         Ts, Zs = zip(*MARTIN_MOYCE)
         ref = float(np.interp(T, Ts, Zs)) if Ts[0] <= T <= Ts[-1] else None
         text = f"surge front Z = z/a = {Z:.3f} at T = t sqrt(2g/a) = {T:.3f}"

@@ -4,7 +4,8 @@ A document is plain nested dicts; its ``origin`` maps each key path (a tuple) to
 that wrote it (a file's label or ``--set``). Merging ``over`` onto ``base``:
 
 - mappings merge key by key, recursively; anything else (numbers, strings, lists) replaces;
-- a key set to null (``~``) removes the base's value, so the default applies again;
+- a key set to null (``~``) removes the base's value, so the default applies again (its origin
+  stays, naming who removed it);
 - alternatives: ``scene.speed`` and ``scene.height`` say the same thing two ways, so giving
   one of them removes the other from the base (``2m-drop`` extends ``3m-drop`` with a height);
 - texts (``title``, ``description``) replace as a whole: a new English title must not keep
@@ -59,6 +60,8 @@ def _merge_into(data: dict, origin: Origin, over: dict, over_origin: Origin, pat
         if value is None:
             data.pop(key, None)
             _drop(origin, p)
+            if p in over_origin:       # the removal keeps its author: what a parent's rung
+                origin[p] = over_origin[p]   # sets for this key does not come back over it
             continue
         if isinstance(value, dict):
             if not isinstance(data.get(key), dict) or p in ATOMIC:

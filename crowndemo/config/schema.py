@@ -131,6 +131,10 @@ NUMERICS_KEYS = {
     "max_mach": number("abort when a speed exceeds this times c", "", 0, 10),
     "max_out_fraction": number("abort when more fluid than this has left the domain", "",
                                0, 1, lo_incl=True),
+    "collision": number("collision distance of the particle collision model, a fraction of "
+                        "l0 (0: off)", "", 0, 1, lo_incl=True, hi_incl=False),
+    "restitution": number("restitution coefficient of the collision model", "", 0, 1,
+                          lo_incl=True),
     "reorder_every": Field("int", "re-sort particles into cell order every N steps (0: never)",
                            lo=0, lo_incl=True, hi=1_000_000),
 }

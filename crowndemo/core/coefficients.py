@@ -15,6 +15,8 @@ class Coefficients:
         self.rho, self.nu, self.c2, self.mass = s(), s(), s(), s()
         self.st_over_m = s()          # C / m of the potential model (S24)
         self.beta = s()               # free-surface threshold (M3)
+        self.col_r2 = s()             # (collision distance)^2 of the collision model
+        self.col_e = s()              # its restitution coefficient
         self.gravity = ti.Vector.field(dim, float, shape=())
         self.domain_lo = ti.Vector.field(dim, float, shape=())
         self.domain_hi = ti.Vector.field(dim, float, shape=())
@@ -32,6 +34,8 @@ class Coefficients:
         self.mass[None] = lattice.mass
         self.st_over_m[None] = lattice.C / lattice.mass
         self.beta[None] = numerics.free_surface_beta(physics.dim)
+        self.col_r2[None] = (numerics.collision * physics.l0) ** 2
+        self.col_e[None] = numerics.restitution
         g = [0.0] * self.dim
         g[-1] = -physics.gravity
         self.gravity[None] = g

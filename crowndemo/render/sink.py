@@ -75,6 +75,14 @@ class FrameSink:
         self.paths.append(path)
         self.frame_seconds.append(_time.perf_counter() - start)
 
+    def release(self) -> None:
+        """Give the window back without encoding anything: the recording never started (a
+        refused resume, a failed set-up)."""
+        if self.status is None:
+            self.status = "released"
+            if self._owns_renderer:
+                self.renderer.close()
+
     def close(self, status: str) -> None:
         """Release the window; encode the video and preview (named by ``status``)."""
         if self.status is not None:
