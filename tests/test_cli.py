@@ -7,7 +7,7 @@ from crowndemo.cli import main
 from crowndemo.core.lattice import n0_lambda0
 
 HELP = [[], ["info"], ["scene"], ["scene", "tank"], ["scene", "dam-break"], ["scene", "patch"],
-        ["bench"]]
+        ["bench"], ["validate"], ["sweep"], ["record"], ["export"], ["play"], ["live"]]
 
 
 @pytest.mark.parametrize("cmd", HELP, ids=lambda c: " ".join(c) or "top")

@@ -50,10 +50,36 @@ def _sweep(args, argv) -> int:
     why = sweep.plot(points, drop, liquid, os.path.join(out, "regime.png"),
                      f"{base.name} ({base.quality}, {base.dim}D, l0 = {base.l0 * 1e3:g} mm), "
                      f"D = {drop * 1e3:g} mm")
+    if args.record:
+        _record(base, table, out, why is None, argv)
     print(table)
     print(f"{PROG}: wrote {out}/regime.md, regime.json"
           + (", regime.png" if why is None else f" (no image: {why})"), file=sys.stderr)
     return 0
+
+
+def _record(base, table: str, out: str, has_image: bool, argv) -> None:
+    """docs/regime.md (and docs/regime.png) at the repository root, linked from VALIDATION.md."""
+    import datetime
+    import shlex
+    import shutil
+
+    from .validate import _machine
+
+    docs = os.path.join(repo_root(), "docs")
+    os.makedirs(docs, exist_ok=True)
+    lines = [f"# Regime map: {base.name} ({base.quality}, {base.dim}D, l0 = "
+             f"{base.l0 * 1e3:g} mm), D = {base.scene['drop'] * 1e3:g} mm", "",
+             "Written by `crowndemo sweep --record`; the verdicts follow the crown rule of "
+             "the README's **validate** section.", "",
+             f"- machine: {_machine()}", f"- date: {datetime.date.today().isoformat()}",
+             f"- command: `{' '.join([PROG] + [shlex.quote(a) for a in argv])}`", ""]
+    if has_image:
+        shutil.copyfile(os.path.join(out, "regime.png"), os.path.join(docs, "regime.png"))
+        lines += ["![regime map](regime.png)", ""]
+    with open(os.path.join(docs, "regime.md"), "w") as f:
+        f.write("\n".join(lines + [table, ""]))
+    print(f"{PROG}: wrote {docs}/regime.md", file=sys.stderr)
 
 
 def register(sub, common) -> None:
@@ -73,4 +99,7 @@ def register(sub, common) -> None:
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help=SET_HELP)
     p.add_argument("--out", metavar="DIR", help="folder for the map (default: reports/)")
+    p.add_argument("--record", action="store_true",
+                   help="also write docs/regime.md and docs/regime.png (linked from "
+                        "VALIDATION.md)")
     p.set_defaults(func=_sweep)

@@ -158,6 +158,11 @@ def _record(result, rows, stab, verd, paths) -> None:
         lines += ["## Stability suite", "", stability.markdown(stab), ""]
     if verd:
         lines += ["## The seed's observations: crown or not", "", verdicts.markdown(verd), ""]
+    lines += ["## Regime map and interpretation", "",
+              "The crown / no-crown regime map against Cossali et al.'s threshold is "
+              "[docs/regime.md](docs/regime.md) (`crowndemo sweep --record`). What these "
+              "numbers mean, and where they fall short, is discussed in the README's "
+              "*Validation status*.", ""]
     with open(os.path.join(root, "VALIDATION.md"), "w") as f:
         f.write("\n".join(lines))
 

@@ -177,7 +177,8 @@ def _laplace(dim: int) -> Case:
 
 # ---- crown base radius -----------------------------------------------------------------------
 def crown_case(preset: str = "quick", t_end: Optional[float] = None,
-               refine: Tuple[float, ...] = (1.0, 0.8, 0.6)) -> Case:
+               refine: Tuple[float, ...] = (1.0, 0.8, 0.6),
+               variants: Tuple[str, ...] = ("untrimmed", "safety/2", "gradient=sum")) -> Case:
     """The crown base radius of a 3D crown preset against Yarin & Weiss's sqrt(t) law, over the
     frames after the crown has formed (tau = t U / D > 0.25 after contact)."""
     from .. import config
@@ -213,8 +214,7 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
                 "Yarin & Weiss 1995 (method.md §7)", "D/l0",
                 tuple(round(base.scene["drop"] / (f * l0), 2) for f in refine),
                 (round(base.scene["drop"] / l0, 2),),
-                lambda s: base.scene["drop"] / s, run,
-                variants=("untrimmed", "safety/2", "gradient=sum"))
+                lambda s: base.scene["drop"] / s, run, variants=variants)
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:
@@ -222,7 +222,9 @@ def all_cases(full: bool = True) -> Dict[str, Case]:
              for d in (2, 3)]
     cases.append(crown_case("quick"))
     if full:
-        cases.append(crown_case("3m-drop", refine=(1.0, 0.85, 0.7)))
+        # the seed's first run, to 1 ms (the drafts' 2 ms at the finest spacing would take
+        # most of an hour on 2 cores); its settings variants are those of crown-base-quick
+        cases.append(crown_case("3m-drop", t_end=1.0e-3, refine=(1.0, 0.85, 0.7), variants=()))
     return {c.name: c for c in cases}
 
 

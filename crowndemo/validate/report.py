@@ -34,7 +34,8 @@ def markdown(rows: Sequence, title: str = "Validation") -> str:
         for r in rs:
             err = f"{100 * r.error:.2f} %" if math.isfinite(r.error) else "-"
             out.append(f"| {r.variant} | {r.resolution} = {r.scale:g} | {r.l0:.3g} | "
-                       f"{r.particles:,} | {r.steps:,} | {r.wall_s:.1f} | {r.compile_s:.1f} | "
+                       f"{f'{r.particles:,}' if r.particles else '-'} | {r.steps:,} | "
+                       f"{r.wall_s:.1f} | {r.compile_s:.1f} | "
                        f"{_fmt(r.measured)} | {_fmt(r.reference)} | {err} | {r.outcome} |")
         out.append("")
     return "\n".join(out)
