@@ -39,4 +39,20 @@ class StopRequest:
             signal.signal(signal.SIGINT, previous)
 
 
-__all__ = ["StopRequest"]
+class StopRun(Exception):
+    """Raised from a step callback to end a run early; ``by`` says why (max-steps, ctrl-c)."""
+
+    def __init__(self, by: str = "max-steps"):
+        super().__init__(by)
+        self.by = by
+
+
+def stop_if_asked(steps: int, max_steps: Optional[int], stop: Optional[StopRequest]) -> None:
+    """Raise StopRun when the run has reached ``max_steps`` or Ctrl-C asked it to stop."""
+    if max_steps is not None and steps >= max_steps:
+        raise StopRun("max-steps")
+    if stop is not None and stop.requested:
+        raise StopRun("ctrl-c")
+
+
+__all__ = ["StopRequest", "StopRun", "stop_if_asked"]

@@ -15,6 +15,7 @@ from typing import Callable, Dict, Optional, Sequence
 
 from ..backend import ARCHS, PRECISIONS
 from ..core.params import Numerics, ParameterError
+from ..interrupt import StopRun, stop_if_asked
 
 PROG = "crowndemo"
 PROGRESS_EVERY_S = 2.0
@@ -70,12 +71,6 @@ def fmt_counts(counts: Dict[str, int]) -> str:
     return ", ".join(parts) + f" ({sum(counts.values()):,} total)"
 
 
-class StopRun(Exception):
-    """Raised from the step callback to end a run early (--max-steps, Ctrl-C)."""
-
-    def __init__(self, by: str = "max-steps"):
-        super().__init__(by)
-        self.by = by
 
 
 class Progress:
@@ -130,10 +125,7 @@ def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
         peak["speed"] = max(peak["speed"], h.max_speed)
         peak["excess"] = max(peak["excess"], h.max_density_excess)
         progress(s)
-        if max_steps is not None and s.stats.steps >= max_steps:
-            raise StopRun("max-steps")
-        if stop is not None and stop.requested:
-            raise StopRun("ctrl-c")
+        stop_if_asked(s.stats.steps, max_steps, stop)
 
     stopped_by = None
     try:

@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Callable, List, Optional, Sequence
 
 from ..core.health import InstabilityError
+from ..interrupt import StopRun, stop_if_asked
 from . import checkpoint as ckpt
 from . import snapshots
 from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike
@@ -19,11 +20,6 @@ from .sinks import COMPLETE, INTERRUPTED, unstable
 
 class RecordError(ValueError):
     """A recording that cannot be made or resumed as asked (one line, for the user)."""
-
-
-class _Stopped(Exception):
-    def __init__(self, by: str):
-        self.by = by
 
 
 @dataclass
@@ -133,18 +129,14 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
         log.note_health(s.stats.health)
         if on_step:
             on_step(s)
-        if max_steps is not None and s.stats.steps >= max_steps:
-            raise _Stopped("max-steps")
-        if stop is not None and stop.requested:
-            raise _Stopped("ctrl-c")
+        stop_if_asked(s.stats.steps, max_steps, stop)
 
     closing = sinks
     try:
-        if max_steps is not None and sim.stats.steps >= max_steps:
-            raise _Stopped("max-steps")
+        stop_if_asked(sim.stats.steps, max_steps, None)
         sim.run(resolved.t_end, frames[start:], on_frame=on_frame, on_step=after_step)
         status = COMPLETE
-    except _Stopped as e:
+    except StopRun as e:
         status, log.stopped_by = INTERRUPTED, e.by
     except InstabilityError as e:
         status, result.error = unstable(str(e)), e
