@@ -15,14 +15,15 @@ from crowndemo.core import FLUID, GONE, Numerics, Physics, Simulator
 L0 = 1.0e-3
 RE_RATIO = 2.1
 RE = RE_RATIO * L0
-MAX_NBR = 160
+MAX_NBR = 256
 BAND = 1e-5          # relative band around re^2 left undecided
 
 
 class Walker:
-    """Records, for each particle i, the j that for_each_neighbour visits (count -1: not walked)."""
+    """Records, for each particle i, the j that for_each_neighbour (or with ``near``, the
+    row-clipping for_each_near of the collision model) visits (count -1: not walked)."""
 
-    def __init__(self, sim: Simulator):
+    def __init__(self, sim: Simulator, near: bool = False):
         cap = sim.state.capacity
         self.nbr = ti.field(ti.i32, (cap, MAX_NBR))
         self.count = ti.field(ti.i32, cap)
@@ -40,7 +41,10 @@ class Walker:
                 c = -1
                 if state.kind[i] != GONE:
                     c = 0
-                    grid.for_each_neighbour(i, state.pos[i], re2, record, c)
+                    if ti.static(near):
+                        grid.for_each_near(i, state.pos[i], re2, record, c)
+                    else:
+                        grid.for_each_neighbour(i, state.pos[i], re2, record, c)
                 count[i] = c
 
         self._walk = walk
@@ -70,18 +74,20 @@ def sims():
             physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0,
                               gravity=0.0)
             sim = Simulator(physics, Numerics(), CAPACITY, max_cells)
-            cache[dim, max_cells] = (sim, Walker(sim))
+            cache[dim, max_cells] = (sim, Walker(sim), Walker(sim, near=True))
         return cache[dim, max_cells]
     return get
 
 
-def load(sims, dim: int, max_cells: int, pos: np.ndarray, kind: np.ndarray):
-    sim, walker = sims(dim, max_cells)
+def load(sims, dim: int, max_cells: int, pos: np.ndarray, kind: np.ndarray,
+         near: bool = False):
+    sim, walker, near_walker = sims(dim, max_cells)
+    walker = near_walker if near else walker
     sim.load(pos, np.zeros_like(pos), kind)
     return sim, walker
 
 
-def brute_force(pos: np.ndarray, kind: np.ndarray, re: float):
+def brute_force(pos: np.ndarray, kind: np.ndarray, re: float = RE):
     """(sure, maybe) boolean matrices: pairs (i, j), both live, i != j, with r^2 below
     re^2 (1 - BAND) (must be found) and below re^2 (1 + BAND) (may be found)."""
     live = kind != GONE
@@ -92,12 +98,12 @@ def brute_force(pos: np.ndarray, kind: np.ndarray, re: float):
 
 
 def check_against_brute_force(sim: Simulator, walker: Walker, pos_f: np.ndarray,
-                              kind: np.ndarray, ids=None):
+                              kind: np.ndarray, ids=None, radius: float = RE):
     """``ids[k]``: the original particle index held at field index k (identity if None)."""
     n = len(pos_f)
     ids = np.arange(n) if ids is None else ids
-    count, nbr = walker.pairs(RE)
-    sure, maybe = brute_force(pos_f, kind, RE)
+    count, nbr = walker.pairs(radius)
+    sure, maybe = brute_force(pos_f, kind, radius)
     found = np.zeros((n, n), dtype=bool)
     for k in range(n):
         i = ids[k]
@@ -215,3 +221,21 @@ def test_single_and_empty_live_sets(sims):
     count, _ = w.pairs(RE)
     assert count[:3].tolist() == [-1, -1, -1]
     assert sim.grid.n_live[None] == 0
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("radius_l0", [0.5, 0.95, RE_RATIO])
+def test_row_clipped_walk_matches_brute_force(sims, dim, radius_l0):
+    """for_each_near (the collision model's walk, rows clipped to the sphere) finds exactly
+    the pairs closer than its radius: the collision distance 0.5 l0, the largest allowed
+    (< 1 l0), and re itself; a dense cloud so that close pairs are many."""
+    rng = np.random.default_rng(50 + dim)
+    n = 600 if dim == 2 else 700
+    side = (n ** (1.0 / dim)) * 0.6 * L0          # mean spacing 0.6 l0
+    pos = rng.uniform(0.0, side, size=(n, dim))
+    kind = np.full(n, FLUID, dtype=np.int32)
+    sim, walker = load(sims, dim, BIG[dim], pos, kind, near=True)
+    sim.grid.build(RE)
+    found = check_against_brute_force(sim, walker, as_loaded(sim), kind,
+                                      radius=radius_l0 * L0)
+    assert found.sum() > 2 * n, "test set-up: too few pairs to test the clipping"

@@ -42,6 +42,10 @@ class CellGrid:
         self.particle_cell = ti.field(ti.i32, state.capacity)
         self.rank = ti.field(ti.i32, state.capacity)
         self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
+        # positions in cell order, copied at the build: the walk tests distances on this
+        # contiguous array and looks up j = order[s] only for the pairs within reach (a
+        # quarter of the candidates). Positions must not change between a build and a walk.
+        self.sorted_pos = ti.Vector.field(d, float, state.capacity)
 
     def set_cell_limit(self, cells: int) -> None:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
@@ -51,7 +55,8 @@ class CellGrid:
     def nbytes(self) -> int:
         from .state import field_nbytes
         return sum(field_nbytes(f) for f in (self.cell_count, self.cell_start, self.block_sum,
-                                             self.particle_cell, self.rank, self.order))
+                                             self.particle_cell, self.rank, self.order,
+                                             self.sorted_pos))
 
     def build(self, min_side: float, reorder: bool = False) -> None:
         """Rebuild at the current positions; with ``reorder`` permute the particles into cell
@@ -61,6 +66,7 @@ class CellGrid:
         if reorder:
             self.state.permute(self.order)
             self._identity_order()
+        self._gather_positions()
 
     # ---- kernels -------------------------------------------------------------------------
     @ti.kernel
@@ -148,6 +154,11 @@ class CellGrid:
                 self.order[self.n_live[None] + ti.atomic_add(self.n_parked[None], 1)] = i
 
     @ti.kernel
+    def _gather_positions(self):
+        for s in range(self.n_live[None]):
+            self.sorted_pos[s] = self.state.pos[self.order[s]]
+
+    @ti.kernel
     def _identity_order(self):
         for k in range(self.state.n[None]):
             self.order[k] = k
@@ -173,25 +184,52 @@ class CellGrid:
     def for_each_neighbour(self, i, xi, re2, task: ti.template(), acc: ti.template()):
         """Call ``task(i, j, rij, r2, acc)`` for every live j != i with r2 = |rij|^2 < re2,
         rij = x_j - x_i. Cells have side >= re/reach, so the (2 reach + 1)^d cells around hold
-        every neighbour; rows of 2 reach + 1 cells along axis 0 are contiguous in cell order."""
+        every neighbour; rows of cells along axis 0 are contiguous in cell order."""
+        self._walk(i, xi, re2, task, acc, False)
+
+    @ti.func
+    def for_each_near(self, i, xi, r2_max, task: ti.template(), acc: ti.template()):
+        """``for_each_neighbour`` for a radius well under re (the collision distance): each
+        row of cells is clipped to the sphere, so only the few cells that reach it are
+        visited. (Clipping costs more per row than it saves at radius re: BENCHMARKS.md.)"""
+        self._walk(i, xi, r2_max, task, acc, True)
+
+    @ti.func
+    def _walk(self, i, xi, re2, task: ti.template(), acc: ti.template(), clip: ti.template()):
         d = ti.static(self.dim)
         c = self.cell_of(xi)
         k = ti.static(self.reach)
+        h = self.side[None]
         for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
             row = c
             inside = True
-            for k in ti.static(range(1, d)):
-                row[k] = c[k] + off[k - 1]
-                if row[k] < 0 or row[k] >= self.dims[k]:
+            gap2 = 0.0      # squared distance from xi to the row's cells across axis 0
+            for m in ti.static(range(1, d)):
+                row[m] = c[m] + off[m - 1]
+                if row[m] < 0 or row[m] >= self.dims[m]:
                     inside = False
-            if inside:
+                if ti.static(clip and off[m - 1] != 0):
+                    lo = self.origin[m] + row[m] * h
+                    gap = lo - xi[m]                     # the row lies above xi on axis m
+                    if ti.static(off[m - 1] < 0):
+                        gap = xi[m] - (lo + h)           # below
+                    gap2 += ti.max(gap, 0.0) ** 2
+            if inside and gap2 < re2:
                 first = ti.max(c[0] - k, 0)
                 last = ti.min(c[0] + k, self.dims[0] - 1)
-                row[0] = first
-                a = self.linear(row)
-                for s in range(self.cell_start[a], self.cell_start[a + last - first + 1]):
-                    j = self.order[s]
-                    rij = self.state.pos[j] - xi
-                    r2 = rij.dot(rij)
-                    if r2 < re2 and j != i:
-                        task(i, j, rij, r2, acc)
+                if ti.static(clip):                      # the sphere's chord along axis 0
+                    half = ti.sqrt(re2 - gap2)
+                    first = ti.max(first, ti.cast(ti.floor((xi[0] - half - self.origin[0]) / h),
+                                                  ti.i32))
+                    last = ti.min(last, ti.cast(ti.floor((xi[0] + half - self.origin[0]) / h),
+                                                ti.i32))
+                if first <= last:
+                    row[0] = first
+                    a = self.linear(row)
+                    for s in range(self.cell_start[a], self.cell_start[a + last - first + 1]):
+                        rij = self.sorted_pos[s] - xi
+                        r2 = rij.dot(rij)
+                        if r2 < re2:
+                            j = self.order[s]
+                            if j != i:
+                                task(i, j, rij, r2, acc)

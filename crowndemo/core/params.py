@@ -81,6 +81,9 @@ class Numerics:
     # without collisions).
     collision: float = 0.5          # collision distance / l0 (0: off; < 1 keeps the lattice free)
     restitution: float = 0.2        # e: the approach speed after a collision is e times before
+    # implementation choices (results equal to float rounding; BENCHMARKS.md has their cost):
+    neighbour_list: bool = True     # the density pass lists each fluid particle's neighbours
+    #                                 for the pressure gradient (core/neighbours.py)
 
     def validate(self, source: str = "parameters") -> "Numerics":
         def need(cond: bool, key: str, allowed: str):
@@ -100,6 +103,7 @@ class Numerics:
         need(_finite(self.collision) and 0 <= self.collision < 1, "collision",
              "0 <= x < 1 (a fraction of l0; 0: off)")
         need(_finite(self.restitution) and 0 <= self.restitution <= 1, "restitution", "0 .. 1")
+        need(isinstance(self.neighbour_list, bool), "neighbour_list", "true or false")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
              "an integer >= 0 (0: never)")
         return self
@@ -117,16 +121,17 @@ class Model:
     gravity: bool
     pressure_gradient: str
     collision: bool = False
+    neighbour_list: bool = True
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
-                   numerics.pressure_gradient, numerics.collision > 0)
+                   numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
                 "gravity": self.gravity, "pressure_gradient": self.pressure_gradient,
-                "collision": self.collision}
+                "collision": self.collision, "neighbour_list": self.neighbour_list}
 
 
 def _finite(x) -> bool:

@@ -10,6 +10,7 @@ import taichi as ti
 
 from .coefficients import Coefficients
 from .grid import CellGrid
+from .neighbours import NeighbourList
 from .operators import gradient_pair, make_density_task, weight
 from .params import Model
 from .state import DUMMY, FLUID, WALL
@@ -29,27 +30,57 @@ def _gradient_sums(dim: int):
                            pmin=float)
 
 
+def _density_sums():
+    return ti.types.struct(n=float, count=ti.i32)
+
+
 @ti.data_oriented
 class Pressure:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
         self.dim = model.dim
         self.sums = _gradient_sums(self.dim)
+        self.density_sums = _density_sums()
         self._density_pair = make_density_task(coef)
+        # not allocated when the model does without (a scene pays for what it uses)
+        self.neighbours = NeighbourList(self.state) if model.neighbour_list else None
+
+    def nbytes(self) -> int:
+        return self.neighbours.nbytes() if self.neighbours is not None else 0
+
+    @ti.func
+    def _density_listing_pair(self, i, j, rij, r2, acc: ti.template()):
+        """The number density's term (S9), and j in i's list unless it is a dummy (the
+        pressure gradient skips dummies, method.md §5)."""
+        acc.n += weight(ti.sqrt(r2), self.coef.re[None])
+        if self.state.kind[j] != DUMMY:
+            acc.count = self.neighbours.add(i, j, acc.count)
 
     @ti.kernel
     def density_and_pressure(self):
-        """n (S9) and P (S17) for fluid and wall particles; dummies only count in n."""
+        """n (S9) and P (S17) for fluid and wall particles; dummies only count in n. With the
+        neighbour list, each fluid particle's non-dummy neighbours are listed on the way."""
         n0, c2, rho, beta = self.coef.n0[None], self.coef.c2[None], self.coef.rho[None], \
             self.coef.beta[None]
         for i in range(self.state.n[None]):
             k = self.state.kind[i]
             if k == FLUID or k == WALL:
-                acc = 0.0
-                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                             self._density_pair, acc)
-                self.state.density[i] = acc
-                self.state.pressure[i] = equation_of_state(acc, n0, c2, rho, beta)
+                n = 0.0
+                if ti.static(self.model.neighbour_list):
+                    if k == FLUID:
+                        acc = self.density_sums(n=0.0, count=0)
+                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                     self._density_listing_pair, acc)
+                        self.neighbours.count[i] = acc.count
+                        n = acc.n
+                    else:
+                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                     self._density_pair, n)
+                else:
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._density_pair, n)
+                self.state.density[i] = n
+                self.state.pressure[i] = equation_of_state(n, n0, c2, rho, beta)
 
     @ti.func
     def _gradient_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -57,24 +88,40 @@ class Pressure:
         neighbour pressure, so every form of (M2) needs a single neighbour pass:
         sum (P_j - P_ref) g_ij = sum P_j g_ij - P_ref sum g_ij."""
         if self.state.kind[j] != DUMMY:
-            p_j = self.state.pressure[j]
-            g = gradient_pair(1.0, rij, r2, weight(ti.sqrt(r2), self.coef.re[None]))
-            acc.pg += p_j * g
-            acc.g += g
-            if ti.static(self.model.pressure_gradient == "pmin"):
-                acc.pmin = ti.min(acc.pmin, p_j)
+            self._gradient_term(j, rij, r2, acc)
+
+    @ti.func
+    def _gradient_term(self, j, rij, r2, acc: ti.template()):
+        p_j = self.state.pressure[j]
+        g = gradient_pair(1.0, rij, r2, weight(ti.sqrt(r2), self.coef.re[None]))
+        acc.pg += p_j * g
+        acc.g += g
+        if ti.static(self.model.pressure_gradient == "pmin"):
+            acc.pmin = ti.min(acc.pmin, p_j)
 
     @ti.kernel
     def correct(self, dt: float):
         """a' = -(1/rho) <grad P> (S18); u += dt a' (S19); r += dt^2 a' (S20).
-        P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum)."""
+        P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum).
+        The neighbours come from the list of ``density_and_pressure`` (same positions) where
+        it holds them all, else from the cell walk."""
         for i in range(self.state.n[None]):
             if self.state.kind[i] == FLUID:
                 p_i = self.state.pressure[i]
+                xi = self.state.pos[i]
                 acc = self.sums(pg=ti.Vector.zero(float, self.dim),
-                                   g=ti.Vector.zero(float, self.dim), pmin=p_i)
-                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                             self._gradient_pair, acc)
+                                g=ti.Vector.zero(float, self.dim), pmin=p_i)
+                walk = True
+                if ti.static(self.model.neighbour_list):
+                    if self.neighbours.fits(i):
+                        walk = False
+                        for m in range(self.neighbours.count[i]):
+                            j = self.neighbours.index[i, m]
+                            rij = self.state.pos[j] - xi
+                            self._gradient_term(j, rij, rij.dot(rij), acc)
+                if walk:
+                    self.grid.for_each_neighbour(i, xi, self.coef.re2[None],
+                                                 self._gradient_pair, acc)
                 p_ref = p_i
                 if ti.static(self.model.pressure_gradient == "pmin"):
                     p_ref = acc.pmin

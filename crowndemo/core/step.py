@@ -25,6 +25,8 @@ from .terms import Predictor
 
 
 BINDINGS = timestep.LIMIT_NAMES + ("fixed", "frame")   # codes of RunStats.bound_log
+# the stages of a step, as timed by Simulator.time_stages (crowndemo bench)
+STAGES = ("grid", "predictor", "collision", "density", "corrector", "health")
 
 
 @dataclass
@@ -78,6 +80,8 @@ class Simulator:
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0
+        self.stage_seconds: Optional[Dict[str, float]] = None   # see time_stages
+        self._stage_t = 0.0
         self.configure(physics, numerics)      # sets physics, numerics and lattice
 
     # ---- set-up --------------------------------------------------------------------------
@@ -128,6 +132,21 @@ class Simulator:
         self.n_fluid = int(saved["n_fluid"])
 
     # ---- the step ------------------------------------------------------------------------
+    def time_stages(self, on: bool = True) -> None:
+        """Time each stage of the step (STAGES) into ``stage_seconds``, from zero. It waits for
+        the device after every stage, so it slows the step a little: for benchmarks only."""
+        self.stage_seconds = dict.fromkeys(STAGES, 0.0) if on else None
+
+    def _stage(self, name: Optional[str]) -> None:
+        """End the stage ``name`` (None: start timing the step)."""
+        if self.stage_seconds is not None:
+            import taichi as ti
+            ti.sync()
+            now = _time.perf_counter()
+            if name is not None:
+                self.stage_seconds[name] += now - self._stage_t
+            self._stage_t = now
+
     def step(self, dt_cap: float = math.inf) -> float:
         """Advance one step; returns dt. Raises InstabilityError on a broken health limit."""
         t_first = _time.perf_counter() if self.stats.steps == 0 else None
@@ -138,12 +157,22 @@ class Simulator:
         re = self.lattice.re
         k = self.stats.steps
         reorder = self.numerics.reorder_every > 0 and k % self.numerics.reorder_every == 0
+        self._stage(None)
         if self.predictor.needs_neighbours:
             self.grid.build(re, reorder=reorder)        # neighbours at r^k
-        self.predictor.run(dt)                          # S14-S16
+            self._stage("grid")
+        self.predictor.accelerate(dt)                   # S14-S15
+        self._stage("predictor")
+        if self.model.collision:
+            self.predictor.collide()
+            self._stage("collision")
+        self.predictor.move(dt)                         # S16
         self.grid.build(re, reorder=reorder and not self.predictor.needs_neighbours)  # at r*
+        self._stage("grid")
         self.pressure.density_and_pressure()            # S17 (M3)
+        self._stage("density")
         self.pressure.correct(dt)                       # S18-S20
+        self._stage("corrector")
         s = self.stats
         s.steps += 1
         s.time += dt
@@ -155,6 +184,7 @@ class Simulator:
         self._last = self._measure()
         if t_first is not None:
             s.first_step_seconds = _time.perf_counter() - t_first
+        self._stage("health")
         Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
                      sound_speed=self.physics.c, max_mach=self.numerics.max_mach,
                      max_density_excess=self.numerics.max_density_excess,
@@ -204,4 +234,5 @@ class Simulator:
         return count_kinds(self.state.kind.to_numpy()[: self.state.count])
 
     def memory_bytes(self) -> int:
-        return self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
+        return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
+                + self.pressure.nbytes())

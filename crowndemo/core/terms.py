@@ -37,6 +37,8 @@ class Predictor:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
         self.dim = model.dim
+        self.pair_sums = ti.types.struct(visc=ti.types.vector(self.dim, float),
+                                         st=ti.types.vector(self.dim, float))
 
     @property
     def needs_neighbours(self) -> bool:
@@ -64,52 +66,72 @@ class Predictor:
 
     @ti.func
     def _pair(self, i, j, rij, r2, acc: ti.template()):
+        """Sums, without their constant factors: sum (u_j - u_i) w (S12; walls have u = 0,
+        no-slip) and sum (r - l0)(r - re) r_ij / r over fluid j (S24)."""
         kind_j = self.state.kind[j]
         if kind_j != DUMMY:
             r = ti.sqrt(r2)
             if ti.static(self.model.viscosity):
-                # nu <lap u> (S12 in S14): walls have u = 0 (no-slip)
-                acc += self.coef.nu[None] * (2.0 * self.dim) / (
-                    self.coef.lambda0[None] * self.coef.n0[None]) * laplacian_pair(
-                    self.state.vel[j] - self.state.vel[i], weight(r, self.coef.re[None]))
+                acc.visc += laplacian_pair(self.state.vel[j] - self.state.vel[i],
+                                           weight(r, self.coef.re[None]))
             if ti.static(self.model.surface_tension):
-                if kind_j == FLUID:      # fluid-fluid potential (S24, sign per method.md §4)
-                    acc += self.coef.st_over_m[None] * surface_tension_pair(
-                        rij, r, self.coef.l0[None], self.coef.re[None])
+                if kind_j == FLUID:      # fluid-fluid potential (sign per method.md §4)
+                    acc.st += surface_tension_pair(rij, r, self.coef.l0[None],
+                                                   self.coef.re[None])
 
-    @ti.kernel
-    def run(self, dt: float):
+    def run(self, dt: float) -> None:
         """u* = u + dt a* (S15), the collision model on u* at r^k, r* = r + dt u* (S16),
         a* from (S14)."""
-        if ti.static(self.needs_neighbours):
+        self.accelerate(dt)
+        if self.model.collision:
+            self.collide()
+        self.move(dt)
+
+    @ti.kernel
+    def accelerate(self, dt: float):
+        """u* = u + dt (nu <lap u> + g + (C/m) sum grad potential) (S14-S15), into vel."""
+        if ti.static(self._pair_terms):
+            visc = self.coef.nu[None] * (2.0 * self.dim) / (
+                self.coef.lambda0[None] * self.coef.n0[None])
             for i in range(self.state.n[None]):
                 if self.state.kind[i] == FLUID:
-                    acc = ti.Vector.zero(float, self.dim)
-                    if ti.static(self._pair_terms):
-                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                                     self._pair, acc)
+                    acc = self.pair_sums(visc=ti.Vector.zero(float, self.dim),
+                                         st=ti.Vector.zero(float, self.dim))
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._pair, acc)
+                    a = ti.Vector.zero(float, self.dim)
+                    if ti.static(self.model.viscosity):
+                        a += visc * acc.visc
+                    if ti.static(self.model.surface_tension):
+                        a += self.coef.st_over_m[None] * acc.st
                     if ti.static(self.model.gravity):
-                        acc += self.coef.gravity[None]
-                    self.state.scratch_vec[i] = self.state.vel[i] + dt * acc
-            if ti.static(self.model.collision):
-                # Jacobi: every pair sees the u* of both before either changes
-                for i in range(self.state.n[None]):
-                    if self.state.kind[i] == FLUID:
-                        self.state.vel[i] = self.state.scratch_vec[i]
-                for i in range(self.state.n[None]):
-                    if self.state.kind[i] == FLUID:
-                        du = ti.Vector.zero(float, self.dim)
-                        self.grid.for_each_neighbour(i, self.state.pos[i],
-                                                     self.coef.col_r2[None],
-                                                     self._collision_pair, du)
-                        self.state.scratch_vec[i] = self.state.vel[i] + du
+                        a += self.coef.gravity[None]
+                    self.state.scratch_vec[i] = self.state.vel[i] + dt * a
             for i in range(self.state.n[None]):
                 if self.state.kind[i] == FLUID:
                     self.state.vel[i] = self.state.scratch_vec[i]
-                    self.state.pos[i] += dt * self.state.vel[i]
-        else:
+        elif ti.static(self.model.gravity):
             for i in range(self.state.n[None]):
                 if self.state.kind[i] == FLUID:
-                    if ti.static(self.model.gravity):
-                        self.state.vel[i] += dt * self.coef.gravity[None]
-                    self.state.pos[i] += dt * self.state.vel[i]
+                    self.state.vel[i] += dt * self.coef.gravity[None]
+
+    @ti.kernel
+    def collide(self):
+        """The collision model on u* at r^k; Jacobi: every pair sees the u* of both before
+        either changes."""
+        for i in range(self.state.n[None]):
+            if self.state.kind[i] == FLUID:
+                du = ti.Vector.zero(float, self.dim)
+                self.grid.for_each_near(i, self.state.pos[i], self.coef.col_r2[None],
+                                        self._collision_pair, du)
+                self.state.scratch_vec[i] = self.state.vel[i] + du
+        for i in range(self.state.n[None]):
+            if self.state.kind[i] == FLUID:
+                self.state.vel[i] = self.state.scratch_vec[i]
+
+    @ti.kernel
+    def move(self, dt: float):
+        """r* = r + dt u* (S16)."""
+        for i in range(self.state.n[None]):
+            if self.state.kind[i] == FLUID:
+                self.state.pos[i] += dt * self.state.vel[i]
