@@ -51,18 +51,33 @@ def block_shape(n: int) -> Tuple[int, int]:
     return k, kz
 
 
-def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0) -> Dict:
-    """Benchmark one block of about ``n`` fluid particles on the running backend."""
+# the seed's formulation with a plain implementation, for ``--compare`` (numerics overrides):
+# the seed's gradient form P_j - P_i (S11 in S18) and no collision model; cells of side re
+# (a 3^d walk), no neighbour list, no re-sort of the particles into cell order
+SEED_NUMERICS = {"pressure_gradient": "seed", "collision": 0.0, "cells_per_re": 1,
+                 "neighbour_list": False, "reorder_every": 0}
+STAGE_STEPS = 5      # extra steps timed stage by stage (each stage waits for the device)
+
+
+def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
+            numerics: Optional[Dict] = None, label: str = "tuned",
+            stages: bool = True) -> Dict:
+    """Benchmark one block of about ``n`` fluid particles on the running backend, with the
+    project's numerics or with ``numerics`` overrides (``label`` names them). With
+    ``stages``, STAGE_STEPS more steps are timed stage by stage (``stage_ms``, per step)."""
     import taichi as ti
 
     from . import backend
     from .core import simulator_for
+    from .core.params import with_values
     from .scenes import hydrostatic_tank
 
     be = backend.current()
     k, kz = block_shape(n)
     t0 = time.perf_counter()
     scene = hydrostatic_tank(dim=3, l0=l0, width=k * l0, depth=kz * l0, re_ratio=2.1)
+    if numerics:
+        scene.numerics = with_values(scene.numerics, **numerics)
     sim = simulator_for(scene)
     ti.sync()
     setup_s = time.perf_counter() - t0
@@ -80,11 +95,22 @@ def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0) -> Dict:
     ti.sync()
     seconds = time.perf_counter() - t
 
+    stage_ms = None
+    if stages:
+        sim.time_stages()
+        for _ in range(STAGE_STEPS):
+            sim.step()
+        stage_ms = {name: 1e3 * v / STAGE_STEPS for name, v in sim.stage_seconds.items() if v}
+        sim.time_stages(False)
+
     counts = sim.counts()
     fluid = sim.n_fluid
     total = sim.state.count
     per_step = seconds / steps
     return {
+        "label": label,
+        "numerics": dict(numerics or {}),
+        "model": sim.model.describe(),
         "n_requested": int(n),
         "block": [k, k, kz],
         "l0_m": l0,
@@ -97,23 +123,29 @@ def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0) -> Dict:
         "compile_s": max(warm[0] - per_step, 0.0),
         "first_step_s": warm[0],
         "setup_s": setup_s,
+        "stage_ms": stage_ms,
         "arch": be.arch,
         "resolved_arch": be.resolved,
         "precision": be.precision,
         "single_thread": be.single_thread,
         "bytes_per_particle": sim.memory_bytes() / total,
+        "memory_bytes": sim.memory_bytes(),
         "dt_s": sim.stats.dt_max,
     }
 
 
 def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
-        on_result=None) -> List[Dict]:
+        on_result=None, compare: bool = False, stages: bool = True) -> List[Dict]:
+    """One result per N; with ``compare``, the seed's formulation (SEED_NUMERICS) first and
+    then the tuned one, for each N, in this process."""
+    variants = [("seed", SEED_NUMERICS), ("tuned", None)] if compare else [("tuned", None)]
     results = []
     for n in ns:
-        r = run_one(n, steps, l0)
-        results.append(r)
-        if on_result:
-            on_result(r)
+        for label, numerics in variants:
+            r = run_one(n, steps, l0, numerics=numerics, label=label, stages=stages)
+            results.append(r)
+            if on_result:
+                on_result(r)
     return results
 
 
@@ -130,21 +162,102 @@ def _row(r: Dict) -> List[str]:
             r["precision"] + (" 1-thread" if r["single_thread"] else "")]
 
 
-def markdown_table(results: Sequence[Dict]) -> str:
-    rows = [list(COLUMNS), ["---:"] * 7 + ["---", "---"]] + [_row(r) for r in results]
-    return "\n".join("| " + " | ".join(row) + " |" for row in rows)
+def _labelled(results: Sequence[Dict]) -> bool:
+    return any(r.get("label", "tuned") != "tuned" for r in results)
 
 
-def text_table(results: Sequence[Dict]) -> str:
-    rows = [list(COLUMNS)] + [_row(r) for r in results]
-    widths = [max(len(row[c]) for row in rows) for c in range(len(COLUMNS))]
+def _rows(results: Sequence[Dict]) -> List[List[str]]:
+    """The main table: a ``variant`` column first when results compare formulations."""
+    head = list(COLUMNS)
+    rows = [_row(r) for r in results]
+    if _labelled(results):
+        head = ["variant"] + head
+        rows = [[r["label"]] + row for r, row in zip(results, rows)]
+    return [head] + rows
+
+
+def stage_rows(results: Sequence[Dict]) -> List[List[str]]:
+    """Milliseconds per step by stage (core/step.py STAGES), with each stage's share."""
+    from .core.step import STAGES
+    timed = [r for r in results if r.get("stage_ms")]
+    if not timed:
+        return []
+    head = (["variant"] if _labelled(results) else []) + ["fluid"] + list(STAGES) + ["sum"]
+    rows = [head]
+    for r in timed:
+        ms = r["stage_ms"]
+        total = sum(ms.values())
+        cells = [f"{ms[s]:.1f} ({100 * ms[s] / total:.0f} %)" if s in ms else "-"
+                 for s in STAGES]
+        rows.append(([r["label"]] if _labelled(results) else [])
+                    + [f"{r['particles']['fluid']:,}"] + cells + [f"{total:.1f}"])
+    return rows
+
+
+def comparison_lines(results: Sequence[Dict]) -> List[str]:
+    """'tuned / seed' throughput ratio per N, where both were run."""
+    lines = []
+    by_n: Dict[int, Dict[str, Dict]] = {}
+    for r in results:
+        by_n.setdefault(r["n_requested"], {})[r.get("label", "tuned")] = r
+    for n, pair in by_n.items():
+        if "seed" in pair and "tuned" in pair:
+            ratio = pair["tuned"]["particle_steps_per_s"] / pair["seed"]["particle_steps_per_s"]
+            lines.append(f"N = {pair['tuned']['particles']['fluid']:,}: tuned / seed = "
+                         f"{ratio:.2f} x")
+    return lines
+
+
+def _right_aligned(rows: List[List[str]], labelled: bool, text_tail: int) -> List[bool]:
+    """Numbers right, words (the variant, and the last ``text_tail`` columns) left."""
+    n = len(rows[0])
+    return [not (labelled and c == 0) and c < n - text_tail for c in range(n)]
+
+
+def _markdown(rows: List[List[str]], right: List[bool]) -> str:
+    align = ["---:" if r else "---" for r in right]
+    return "\n".join("| " + " | ".join(row) + " |" for row in [rows[0], align] + rows[1:])
+
+
+def _text(rows: List[List[str]], right: List[bool]) -> List[str]:
+    widths = [max(len(row[c]) for row in rows) for c in range(len(rows[0]))]
     lines = []
     for i, row in enumerate(rows):
-        cells = [cell.rjust(w) if c < 7 else cell.ljust(w)
+        cells = [cell.rjust(w) if right[c] else cell.ljust(w)
                  for c, (cell, w) in enumerate(zip(row, widths))]
         lines.append("  ".join(cells).rstrip())
         if i == 0:
             lines.append("  ".join("-" * w for w in widths))
+    return lines
+
+
+def _tables(results: Sequence[Dict]):
+    """(main rows, its alignment, stage rows, their alignment, ratio lines)."""
+    lab = _labelled(results)
+    rows = _rows(results)
+    stages = stage_rows(results)
+    return (rows, _right_aligned(rows, lab, 2), stages,
+            _right_aligned(stages, lab, 0) if stages else [], comparison_lines(results))
+
+
+def markdown_table(results: Sequence[Dict]) -> str:
+    rows, right, stages, stage_right, ratios = _tables(results)
+    out = _markdown(rows, right)
+    if stages:
+        out += (f"\n\nTime per step by stage, ms (share), from {STAGE_STEPS} more steps timed "
+                "stage by stage:\n\n" + _markdown(stages, stage_right))
+    if ratios:
+        out += "\n\n" + "\n".join(f"- {line}" for line in ratios)
+    return out
+
+
+def text_table(results: Sequence[Dict]) -> str:
+    rows, right, stages, stage_right, ratios = _tables(results)
+    lines = _text(rows, right)
+    if stages:
+        lines += ["", "time per step by stage, ms (share):"] + _text(stages, stage_right)
+    if ratios:
+        lines += [""] + ratios
     return "\n".join(lines)
 
 

@@ -17,10 +17,19 @@ examples:
   crowndemo bench --n 2000 --steps 3 --json   # a quick check
   crowndemo bench --arch cuda --n 1000000     # on an NVIDIA GPU
   crowndemo bench --record                    # append the results to BENCHMARKS.md
+  crowndemo bench --compare --n 100000        # the seed's formulation against the tuned one
 
 The scene is a k x k x kz block of water (k = round(N^(1/3)), l0 = 1 mm, re = 2.1 l0) resting
 in a 3D tank with walls. particle-steps/s = fluid particles x steps / seconds; the first steps
-(JIT compile) are not timed and are reported as compile_s.
+(JIT compile) are not timed and are reported as compile_s. Then 5 more steps are timed stage by
+stage (grid, predictor, collision, density, corrector, health; each stage waits for the device,
+so their sum is a little over a normal step). bytes/particle: the simulator's fields (particles,
+cell grid, neighbour list) over all particles, walls included.
+
+--compare runs each N twice in one process: "seed" is the seed's formulation with a plain
+implementation (gradient P_j - P_i, no collision model, cells of side re, no neighbour list, no
+re-sort); "tuned" is the project's default (pmin gradient, collisions, cells of side re/2, the
+neighbour list, re-sort every step). It prints tuned / seed.
 """
 
 
@@ -37,10 +46,12 @@ def _bench(args, argv: Sequence[str]) -> int:
 
     def progress(r):
         if not args.json:
-            print(f"  N = {r['particles']['fluid']:,}: {r['particle_steps_per_s']:.3e} "
+            label = f" ({r['label']})" if args.compare else ""
+            print(f"  N = {r['particles']['fluid']:,}{label}: {r['particle_steps_per_s']:.3e} "
                   f"particle-steps/s", file=sys.stderr, flush=True)
 
-    results = bench.run(ns, args.steps, on_result=progress)
+    results = bench.run(ns, args.steps, on_result=progress, compare=args.compare,
+                        stages=not args.no_stages)
     if args.json:
         print(json.dumps(results[0] if len(results) == 1 else results, indent=2))
     else:
@@ -62,6 +73,10 @@ def register(sub, common) -> None:
     p.add_argument("--steps", type=int, default=20, metavar="S", help="timed steps per run (default: 20)")
     p.add_argument("--json", action="store_true",
                    help="one JSON object per N (a list when several)")
+    p.add_argument("--compare", action="store_true",
+                   help="run the seed's formulation and the tuned one for each N; print the ratio")
+    p.add_argument("--no-stages", action="store_true",
+                   help="skip the stage-by-stage timing (5 extra steps per run)")
     p.add_argument("--record", action="store_true",
                    help="append a section (machine, arch, date, command, table) to BENCHMARKS.md "
                         "at the repository root")

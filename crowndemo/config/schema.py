@@ -137,6 +137,10 @@ NUMERICS_KEYS = {
                           lo_incl=True),
     "reorder_every": Field("int", "re-sort particles into cell order every N steps (0: never)",
                            lo=0, lo_incl=True, hi=1_000_000),
+    "neighbour_list": Field("bool", "list each fluid particle's neighbours in the density pass "
+                            "for the pressure gradient (same results, faster)", default=True),
+    "cells_per_re": Field("int", "cells of side re/k: the neighbour walk visits (2k + 1)^d cells",
+                          lo=1, lo_incl=True, hi=3, hi_incl=True),
 }
 
 RUNG_KEYS = {

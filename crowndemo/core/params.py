@@ -84,6 +84,7 @@ class Numerics:
     # implementation choices (results equal to float rounding; BENCHMARKS.md has their cost):
     neighbour_list: bool = True     # the density pass lists each fluid particle's neighbours
     #                                 for the pressure gradient (core/neighbours.py)
+    cells_per_re: int = 2           # cells of side re/k, a walk over (2k + 1)^d cells (grid.py)
 
     def validate(self, source: str = "parameters") -> "Numerics":
         def need(cond: bool, key: str, allowed: str):
@@ -104,6 +105,8 @@ class Numerics:
              "0 <= x < 1 (a fraction of l0; 0: off)")
         need(_finite(self.restitution) and 0 <= self.restitution <= 1, "restitution", "0 .. 1")
         need(isinstance(self.neighbour_list, bool), "neighbour_list", "true or false")
+        need(isinstance(self.cells_per_re, int) and not isinstance(self.cells_per_re, bool)
+             and 1 <= self.cells_per_re <= 3, "cells_per_re", "1, 2 or 3")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
              "an integer >= 0 (0: never)")
         return self
@@ -122,16 +125,19 @@ class Model:
     pressure_gradient: str
     collision: bool = False
     neighbour_list: bool = True
+    cells_per_re: int = 2
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
-                   numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list)
+                   numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
+                   numerics.cells_per_re)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
                 "gravity": self.gravity, "pressure_gradient": self.pressure_gradient,
-                "collision": self.collision, "neighbour_list": self.neighbour_list}
+                "collision": self.collision, "neighbour_list": self.neighbour_list,
+                "cells_per_re": self.cells_per_re}
 
 
 def _finite(x) -> bool:

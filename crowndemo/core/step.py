@@ -71,7 +71,8 @@ class Simulator:
         dim = physics.dim
         self.state = ParticleState(dim, capacity)
         self._auto_cells = max_cells is None    # then the cell limit follows the particles
-        self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity))
+        self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity),
+                             self.model.cells_per_re)
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.predictor = Predictor(self.model, self.grid, self.coef)
