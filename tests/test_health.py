@@ -38,3 +38,22 @@ def test_too_many_leaving_particles_abort_the_run():
     with pytest.raises(InstabilityError, match="left the domain"):
         sim.run(0.02)
     assert sim.stats.health.left_total == 3
+
+
+def test_run_stats_keep_the_peak_of_every_step():
+    """RunStats holds the largest max speed and density excess over the run (the summaries,
+    recordings and the stability report read them there): equal to the maximum over every
+    step's report, not the last one. A falling column: the speed grows, then the front slows."""
+    from crowndemo.core import simulator_for
+    from crowndemo.scenes import dam_break
+    sim = simulator_for(dam_break(dim=2, a=0.02, l0=2e-3))
+    speeds = [sim.stats.health.max_speed]
+    excess = [sim.stats.health.max_density_excess]
+
+    def on_step(s):
+        speeds.append(s.stats.health.max_speed)
+        excess.append(s.stats.health.max_density_excess)
+    sim.run(0.03, on_step=on_step)
+    assert sim.stats.peak_max_speed == max(speeds) > 0.1
+    assert sim.stats.peak_max_density_excess == max(excess)
+    assert sim.stats.as_dict()["health"]["peak_max_speed_m_s"] == max(speeds)

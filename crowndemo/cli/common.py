@@ -116,14 +116,9 @@ def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
     """Run ``sim`` to ``t_end`` (or ``max_steps``, or until ``stop.requested``: Ctrl-C) with a
     progress line on stderr every ~2 s; returns the stats, the peak health figures, whether
     and why the run stopped early (stopped_by: max-steps | ctrl-c) and the first step's time."""
-    h0 = sim.stats.health
-    peak = {"speed": h0.max_speed, "excess": h0.max_density_excess}
     progress = Progress(t_end, quiet, max_steps, first_label)
 
     def on_step(s):
-        h = s.stats.health
-        peak["speed"] = max(peak["speed"], h.max_speed)
-        peak["excess"] = max(peak["excess"], h.max_density_excess)
         progress(s)
         stop_if_asked(s.stats.steps, max_steps, stop)
 
@@ -132,6 +127,7 @@ def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
         stats = sim.run(t_end, frame_times=frame_times, on_frame=on_frame, on_step=on_step)
     except StopRun as e:
         stats, stopped_by = sim.stats, e.by
+    peak = {"speed": stats.peak_max_speed, "excess": stats.peak_max_density_excess}
     return {"stats": stats, "peak": peak, "stopped_early": stopped_by is not None,
             "stopped_by": stopped_by, "first_step_s": progress.first_step_s}
 
@@ -148,8 +144,6 @@ def clock(seconds: float) -> str:
 def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:
     """The JSON part shared by `scene` and `run`: stats, health with peaks, particles."""
     d = run["stats"].as_dict()
-    d["health"]["peak_max_speed_m_s"] = run["peak"]["speed"]
-    d["health"]["peak_max_density_excess"] = run["peak"]["excess"]
     return {"particles": counts, "setup_seconds": setup_s, **d}
 
 

@@ -137,8 +137,8 @@ def _record(args) -> int:
             out.append({"folder": str(folder), **meta})
             if not args.json:
                 run = {"stats": res.sim.stats, "stopped_by": res.log.stopped_by,
-                       "peak": {"speed": res.log.peak_max_speed,
-                                "excess": res.log.peak_max_density_excess}}
+                       "peak": {"speed": res.sim.stats.peak_max_speed,
+                                "excess": res.sim.stats.peak_max_density_excess}}
                 head = (f"preset {r.name} ({r.quality}): {r.dim}D, l0 = {r.l0:g} m, U = "
                         f"{r.speed:.4g} m/s; arch {be.resolved}, {be.precision}")
                 print_summary(head, run, res.sim.counts(), res.scene.physics.c,

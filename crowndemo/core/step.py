@@ -42,6 +42,15 @@ class RunStats:
     first_step_seconds: float = 0.0   # the first step of a simulator compiles its kernels
     energy_start: Optional[float] = None
     health: HealthReport = field(default_factory=HealthReport)
+    peak_max_speed: float = 0.0            # the largest of every step's health figures
+    peak_max_density_excess: float = 0.0
+
+    def note(self, report: HealthReport) -> None:
+        """Take one step's health report (the last one, and into the peaks)."""
+        self.health = report
+        self.peak_max_speed = max(self.peak_max_speed, report.max_speed)
+        self.peak_max_density_excess = max(self.peak_max_density_excess,
+                                           report.max_density_excess)
 
     def as_dict(self) -> dict:
         h = self.health
@@ -50,6 +59,8 @@ class RunStats:
                 "wall_seconds": self.wall_seconds,
                 "health": {"max_speed_m_s": h.max_speed,
                            "max_density_excess": h.max_density_excess,
+                           "peak_max_speed_m_s": self.peak_max_speed,
+                           "peak_max_density_excess": self.peak_max_density_excess,
                            "energy_J": h.energy, "energy_start_J": self.energy_start,
                            "left_domain": dict(h.left), "nonfinite": h.nonfinite}}
 
@@ -194,7 +205,7 @@ class Simulator:
 
     def _measure(self) -> HealthReport:
         report = self.health.measure()
-        self.stats.health = report
+        self.stats.note(report)
         return report
 
     def run(self, t_end: float, frame_times: Sequence[float] = (),

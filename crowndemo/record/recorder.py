@@ -106,7 +106,6 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
         log, start = saved.log, saved.next_frame
     else:
         log, start = RunLog(), 0
-        log.note_health(sim.stats.health)
     result = RecordResult("running", folder, resolved, scene, sim, log, frames, saved,
                           replaced_frames=replaced)
     checkpoint = ckpt.CheckpointSink(folder / CHECKPOINT, sim, log, print_, checkpoint_every,
@@ -126,7 +125,6 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
             sink.frame(s, index, frames[index])
 
     def after_step(s) -> None:
-        log.note_health(s.stats.health)
         if on_step:
             on_step(s)
         stop_if_asked(s.stats.steps, max_steps, stop)

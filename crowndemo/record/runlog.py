@@ -1,5 +1,5 @@
-"""The bookkeeping of one recording that is not in the simulator: the frames written, health
-peaks, wall times and the starts (a resumed run adds one). Saved inside the checkpoint, so a
+"""The bookkeeping of one recording that is not in the simulator: the frames written, wall
+times and the starts (a resumed run adds one); health peaks are in the simulator's RunStats. Saved inside the checkpoint, so a
 resumed run continues it."""
 from __future__ import annotations
 
@@ -12,8 +12,6 @@ from typing import List, Optional
 @dataclass
 class RunLog:
     frames: List[dict] = field(default_factory=list)   # index, time_s, file, wall_s
-    peak_max_speed: float = 0.0
-    peak_max_density_excess: float = 0.0
     setup_seconds: float = 0.0        # summed over the starts
     starts: List[dict] = field(default_factory=list)   # started (UTC), from_step, setup_s
     stopped_by: Optional[str] = None  # "ctrl-c" | "max-steps" when interrupted
@@ -26,11 +24,6 @@ class RunLog:
         self.starts.append({"started_utc": datetime.now(timezone.utc).isoformat(
             timespec="seconds"), "from_step": from_step, "setup_seconds": setup_s})
         self._stamp = time.perf_counter()
-
-    def note_health(self, report) -> None:
-        self.peak_max_speed = max(self.peak_max_speed, report.max_speed)
-        self.peak_max_density_excess = max(self.peak_max_density_excess,
-                                           report.max_density_excess)
 
     def add_frame(self, index: int, time_s: float, file: str) -> None:
         """A frame whose files are written; wall_s: wall time since the previous frame."""
@@ -45,7 +38,8 @@ class RunLog:
 
     @classmethod
     def from_json(cls, data: dict) -> "RunLog":
-        return cls(**data)
+        known = set(cls.__dataclass_fields__)
+        return cls(**{k: v for k, v in data.items() if k in known})   # older: peaks here
 
 
 __all__ = ["RunLog"]

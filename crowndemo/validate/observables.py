@@ -37,6 +37,34 @@ def surge_front(pos: np.ndarray, l0: float, axis: int = 0, link: float = LINK_L0
     return float(pos[body, axis].max() + 0.5 * l0)
 
 
+# Largest time-origin shift the dam-break comparison may fit (T units, T = t sqrt(2 g / a)).
+# Why a shift at all: from T = 0.8 to 6.8 the converged 2D runs (a/l0 = 25, 50) follow
+# Martin & Moyce's whole curve shifted by one constant dT = 0.27-0.31 within 3-5 %, while the
+# first motion (T <= 0.5) agrees with the exact t -> 0 potential-flow solution for the column
+# (foot acceleration 2.6-3.1 g). A dissipative cause (friction, viscosity) would give a lag
+# that grows with time, not a constant one: nu = 1e-4 falls from 1.09 to 0.80 of the data by
+# T = 6.8, and no shift fits it. A constant offset is a difference of time origin: the
+# experiment's liquid was not free at its t = 0 (the release of the column). The unshifted
+# error is reported beside the shifted one.
+DAM_BREAK_MAX_SHIFT = 0.4
+
+
+def fit_time_origin(T: np.ndarray, Z: np.ndarray, T_ref: np.ndarray, Z_ref: np.ndarray,
+                    max_shift: float = DAM_BREAK_MAX_SHIFT) -> dict:
+    """Compare a front Z(T) (sampled densely on T) with reference points after shifting the
+    reference's time origin by the dT in [0, max_shift] (steps of max_shift/80) that makes the
+    worst relative error least: Z(T_ref - dT) / Z_ref. Returns the shift, the ratios with it,
+    the worst error with it and the worst error without it."""
+    T, Z = np.asarray(T, float), np.asarray(Z, float)
+    T_ref, Z_ref = np.asarray(T_ref, float), np.asarray(Z_ref, float)
+    shifts = np.linspace(0.0, max_shift, 81)
+    worst = [float(np.abs(np.interp(T_ref - d, T, Z) / Z_ref - 1).max()) for d in shifts]
+    best = int(np.argmin(worst))
+    ratios = np.interp(T_ref - shifts[best], T, Z) / Z_ref
+    return {"shift": float(shifts[best]), "ratios": ratios, "worst": worst[best],
+            "worst_unshifted": worst[0]}
+
+
 def _pair_geometry(p: np.ndarray, re: float):
     d = p[None, :, :] - p[:, None, :]                 # r_j - r_i, [i, j]
     r = np.linalg.norm(d, axis=2)

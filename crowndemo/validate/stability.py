@@ -147,14 +147,9 @@ def run_case(case: StabilityCase, t_end: float) -> StabilityRow:
                             time.perf_counter() - t0, math.nan, math.nan, {}, 0.0, 0.0,
                             scene.physics.c, math.nan, math.nan, {}, 0,
                             f"refused: {e}", "fixed_dt" == e.key, [])
-    peak = {"excess": 0.0, "speed": 0.0}
-
-    def on_step(s):
-        peak["excess"] = max(peak["excess"], s.stats.health.max_density_excess)
-        peak["speed"] = max(peak["speed"], s.stats.health.max_speed)
     outcome = "ran to the end"
     try:
-        sim.run(t_end, on_step=on_step)
+        sim.run(t_end)
     except InstabilityError as e:
         outcome = f"stopped: {e.what} at step {e.step}, t = {e.time * 1e3:.4g} ms (dt bound by {e.binding})"
     st, h = sim.stats, sim.stats.health
@@ -162,8 +157,8 @@ def run_case(case: StabilityCase, t_end: float) -> StabilityRow:
     if outcome == "ran to the end":
         if h.nonfinite:
             checks.append(f"{h.nonfinite} non-finite values")
-        if peak["excess"] > scene.numerics.max_density_excess:
-            checks.append(f"density excess {peak['excess']:.3g} over the limit")
+        if st.peak_max_density_excess > scene.numerics.max_density_excess:
+            checks.append(f"density excess {st.peak_max_density_excess:.3g} over the limit")
         if (not case.energy_source and st.energy_start is not None
                 and h.energy > st.energy_start + ENERGY_GROWTH * abs(st.energy_start)):
             checks.append(f"energy grew {h.energy / st.energy_start - 1:+.1%} with no source")
@@ -173,7 +168,7 @@ def run_case(case: StabilityCase, t_end: float) -> StabilityRow:
             checks.append(f"{n_gone} particles gone but {n_out} counted")
     return StabilityRow(case.name, case.kind, case.what, counts["total"], st.steps, t_end,
                         st.time, time.perf_counter() - t0, st.dt_min, st.dt_max,
-                        dict(st.binding), peak["excess"], peak["speed"], scene.physics.c,
+                        dict(st.binding), st.peak_max_density_excess, st.peak_max_speed, scene.physics.c,
                         st.energy_start if st.energy_start is not None else math.nan, h.energy,
                         dict(h.left), int(h.nonfinite), outcome, not checks, checks)
 
