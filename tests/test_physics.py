@@ -7,7 +7,9 @@ import pytest
 from crowndemo.core import (FLUID, InstabilityError, Numerics, ParameterError, simulator_for)
 from crowndemo.scenes import circularity, dam_break, hydrostatic_tank, square_patch
 from crowndemo.validate.cases import fluid_pressure_profile
-from crowndemo.validate.observables import fit_time_origin, surge_front
+from crowndemo.scenes.drop import resting_drop
+from crowndemo.validate.observables import (fit_time_origin, lattice_cohesion_pressure,
+                                            mechanical_pressure, surge_front)
 
 RHO, G = 998.0, 9.81
 
@@ -72,6 +74,39 @@ def test_square_patch_rounds_up_without_gravity():
     c1 = circularity(sim.snapshot()["pos"], l0)
     assert c1 > 0.97 and c1 > c0 + 0.1
     assert sim.stats.health.left_total == 0
+
+
+def test_resting_drop_inside_pressure_2d():
+    """What the potential model gives inside a resting 2D drop (R = 12 l0), against physics:
+    the equation-of-state pressure balances the lattice's cohesive stress (computed from C on a
+    perfect lattice, S22) plus the Laplace jump sigma/R, so it equals -P_coh + sigma/R within
+    the ~1 % compression the sound speed allows (-P_coh = 2.25 sigma/l0, the jump 3.7 % of
+    it); and the total (virial) pressure, the jump itself, is positive and of order sigma/R.
+    Issue 2 asks for the jump within 25 %: the virial measures 1.08-1.54 sigma/R for R/l0 =
+    8-24 and 0.3 at 32 (README, Validation status): not asserted, because the small difference
+    of two terms of ~2.3 (R/l0) sigma/R does not converge."""
+    l0, R = 1.0e-4, 1.2e-3
+    scene = resting_drop(dim=2, radius=R, l0=l0, nu=1.0e-4, t_end=0.01,
+                         numerics=Numerics(pressure_gradient="sum"))
+    sim = simulator_for(scene)
+    ph, lat = sim.physics, sim.lattice
+    dt = min(sim.numerics.acoustic * l0 / ph.c,
+             sim.numerics.capillary * math.sqrt(ph.rho * l0 ** 3 / (2 * math.pi * ph.sigma)))
+    virial, eos = [], []
+
+    def sample(s, i):
+        p = s.snapshot()["pos"].astype(float)
+        inner = np.linalg.norm(p - p.mean(axis=0), axis=1) < 0.5 * R
+        v = mechanical_pressure(p, lat.l0, lat.re, lat.n0, ph.rho, lat.C, lat.mass, ph.c ** 2,
+                                s.numerics.free_surface_beta(2), dt)
+        virial.append(float(v[inner].mean()))
+        s.refresh_pressure()
+        eos.append(float(s.snapshot()["pressure"][inner].mean()))
+    sim.run(scene.t_end, frame_times=np.linspace(0.003, scene.t_end, 15), on_frame=sample)
+    jump = ph.sigma / R
+    cohesion = -lattice_cohesion_pressure(2, l0, lat.re, lat.C)
+    assert np.mean(eos) == pytest.approx(cohesion + jump, rel=0.02)
+    assert 0.0 < np.mean(virial) < 2.0 * jump
 
 
 def test_instability_is_caught_with_the_step_and_limit():
