@@ -373,3 +373,23 @@ def test_yaml_reads_exponent_floats_and_the_schema_covers_numerics(tmp_path):
     assert load_text("a: 1e-3\nb: 2E5\nc: 7\nd: .inf\n", "x") == {
         "a": 1e-3, "b": 2e5, "c": 7, "d": math.inf}
     assert set(schema.NUMERICS_KEYS) == {f.name for f in fields(Numerics)} - {"allow_unsafe_dt"}
+
+
+def test_run_time_estimate_reads_the_tuned_rows_of_a_compare_table(tmp_path):
+    """`bench --compare` sections label their rows seed / tuned: the estimate takes the tuned
+    figure (what runs) of the newest section, at its largest N."""
+    md = tmp_path / "BENCHMARKS.md"
+    md.write_text(
+        "# Benchmarks\n\n## 2026-01-01 00:00 UTC\n\n- machine: X, 2 cores\n\n"
+        "| fluid | total | steps | seconds | particle-steps/s | compile s | bytes/particle | arch "
+        "| precision |\n| ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | --- |\n"
+        "| 1,000 | 2,000 | 20 | 1.0 | 1.000e+05 | 1.00 | 92 | cpu (x64) | f32 |\n\n"
+        "## 2026-01-02 00:00 UTC\n\n- machine: Y, 2 cores\n\n"
+        "| variant | fluid | total | steps | seconds | particle-steps/s | compile s | "
+        "bytes/particle | arch | precision |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: "
+        "| ---: | --- | --- |\n"
+        "| seed | 3,000 | 4,500 | 20 | 1.0 | 5.000e+05 | 1.00 | 104 | cpu (x64) | f32 |\n"
+        "| tuned | 3,000 | 4,500 | 20 | 1.0 | 9.000e+05 | 2.00 | 332 | cpu (x64) | f32 |\n")
+    tp = estimate.throughput(md)
+    assert tp.rate == 9.0e5 and tp.bytes_per_particle == 332 and tp.total_per_fluid == 1.5
+    assert "Y" in tp.source

@@ -79,6 +79,10 @@ def _parse_benchmarks(path: Path) -> Optional[Throughput]:
         rows = []
         for line in section.splitlines():
             cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if cells and cells[0] in ("seed", "tuned"):     # a `bench --compare` table
+                if cells[0] != "tuned":
+                    continue                  # the seed's formulation is not what runs
+                cells = cells[1:]
             if len(cells) < 9 or not re.fullmatch(r"[\d,]+", cells[0]):
                 continue
             try:
