@@ -82,6 +82,8 @@ def test_dam_break_case_reports_worst_point():
     assert row.error < 0.10
     assert 0.0 < row.extra["time origin dT"] <= 0.4
     assert row.extra["worst without dT"] > row.error
+    from crowndemo.validate.report import markdown
+    assert "time origin dT" in markdown([row]) and "worst without dT" in markdown([row])
 
 
 # ---- quick stability subset ---------------------------------------------------------------------

@@ -19,6 +19,16 @@ def _fmt(v) -> str:
     return str(v)
 
 
+# extras shown under a case's table, one line per run (errors as per cent)
+SHOWN_EXTRAS = {"time origin dT": "{:.3g}", "worst without dT": "{:.2%}"}
+
+
+def _shown_extras(r) -> str:
+    parts = [f"{k} {fmt.format(r.extra[k])}" for k, fmt in SHOWN_EXTRAS.items()
+             if isinstance(r.extra.get(k), float) and math.isfinite(r.extra[k])]
+    return ", ".join(parts)
+
+
 def markdown(rows: Sequence, title: str = "Validation") -> str:
     """One table per case: a row per run, the error in per cent."""
     out: List[str] = []
@@ -37,6 +47,11 @@ def markdown(rows: Sequence, title: str = "Validation") -> str:
                        f"{f'{r.particles:,}' if r.particles else '-'} | {r.steps:,} | "
                        f"{r.wall_s:.1f} | {r.compile_s:.1f} | "
                        f"{_fmt(r.measured)} | {_fmt(r.reference)} | {err} | {r.outcome} |")
+        notes = [(r, _shown_extras(r)) for r in rs]
+        if any(text for _, text in notes):
+            out.append("")
+            out += [f"- {r.variant}, {r.resolution} = {r.scale:g}: {text}"
+                    for r, text in notes if text]
         out.append("")
     return "\n".join(out)
 
