@@ -140,3 +140,17 @@ def test_time_origin_fit_recovers_a_known_shift():
     assert fit["worst"] < 0.01 and fit["worst_unshifted"] > 0.05
     slow = np.interp(T, curve_T, curve_Z) * np.exp(-0.04 * T)   # a growing lag
     assert fit_time_origin(T, slow, T_ref, Z_ref)["worst"] > 0.10
+
+
+def test_verdict_looks_at_the_seed_frames():
+    """A verdict run measures the crown at the seed's frames (2, 3, 4 ms) up to its end time
+    and at the end; it is a crown when one stands at any of them."""
+    assert verdicts.observation_times(2.0e-3) == [2.0e-3]
+    assert verdicts.observation_times(4.5e-3) == [2.0e-3, 3.0e-3, 4.0e-3, 4.5e-3]
+    assert verdicts.observation_times(1.0e-3) == [1.0e-3]
+    v = verdicts.run_preset("quick-2d", "draft", ["scene.t_end=2.5e-3"])
+    assert [round(o["time"] * 1e3, 6) for o in v.series] == [2.0, 2.5]
+    assert v.crown == any(o["crown"] for o in v.series)
+    assert v.crown_times == [o["time"] for o in v.series if o["crown"]]
+    table = verdicts.markdown([v])
+    assert "crown at (ms)" in table and "| 2, 2.5 |" in table
