@@ -122,6 +122,7 @@ def test_instability_is_caught_with_the_step_and_limit():
     assert e.dt == pytest.approx(10 * acoustic) and e.time == pytest.approx(e.step * e.dt)
     assert "unstable at step" in str(e) and "Remedy" in str(e)
     assert any(w in e.what for w in ("non-finite", "density excess", "max_mach"))
+    assert e.particles == len(scene.pos)            # reports of the run can say how big it was
 
 
 def test_unsafe_fixed_dt_is_refused_before_the_run():

@@ -40,6 +40,7 @@ class InstabilityError(RuntimeError):
     def __init__(self, step: int, time: float, what: str, binding: str, dt: float, remedy: str):
         self.step, self.time, self.what, self.binding, self.dt, self.remedy = \
             step, time, what, binding, dt, remedy
+        self.particles = 0      # the simulator's particle count, set by Simulator.step
         super().__init__(
             f"unstable at step {step} (t = {time * 1e3:.4g} ms): {what}; the time step "
             f"dt = {dt:.3g} s was bound by the {binding} limit. Remedy: {remedy}")

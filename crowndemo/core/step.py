@@ -15,7 +15,7 @@ import numpy as np
 from . import timestep
 from .coefficients import Coefficients
 from .grid import CellGrid
-from .health import Health, HealthReport, count_kinds
+from .health import Health, HealthReport, InstabilityError, count_kinds
 from .lattice import LatticeConstants
 from .operators import Operators
 from .params import Model, Numerics, Physics
@@ -197,10 +197,14 @@ class Simulator:
         if t_first is not None:
             s.first_step_seconds = _time.perf_counter() - t_first
         self._stage("health")
-        Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
-                     sound_speed=self.physics.c, max_mach=self.numerics.max_mach,
-                     max_density_excess=self.numerics.max_density_excess,
-                     n_fluid=self.n_fluid, max_out_fraction=self.numerics.max_out_fraction)
+        try:
+            Health.check(self._last, step=s.steps, time=s.time, dt=dt, binding=binding,
+                         sound_speed=self.physics.c, max_mach=self.numerics.max_mach,
+                         max_density_excess=self.numerics.max_density_excess,
+                         n_fluid=self.n_fluid, max_out_fraction=self.numerics.max_out_fraction)
+        except InstabilityError as e:
+            e.particles = self.state.count        # for reports of runs built out of sight
+            raise
         return dt
 
     def _measure(self) -> HealthReport:

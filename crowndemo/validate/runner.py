@@ -45,7 +45,7 @@ def run_one(case: Case, scale: float, variant: str = "base") -> Row:
     try:
         res = case.run(l0, numerics, **opts)
     except InstabilityError as e:
-        return Row(case.name, case.dim, variant, case.resolution, scale, l0, 0, e.step,
+        return Row(case.name, case.dim, variant, case.resolution, scale, l0, e.particles, e.step,
                    time.perf_counter() - t0, 0.0, math.nan, math.nan, math.inf,
                    f"unstable: {e.what} at step {e.step}, t = {e.time * 1e3:.4g} ms",
                    case.quantity)
