@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Dict, Optional, Tuple
 
-from ..core.params import GRADIENT_FORMS
+from ..core.params import GRADIENT_FORMS, WALL_MODELS
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
 
@@ -141,6 +141,8 @@ NUMERICS_KEYS = {
                             "for the pressure gradient (same results, faster)", default=True),
     "cells_per_re": Field("int", "cells of side re/k: the neighbour walk visits (2k + 1)^d cells",
                           lo=1, lo_incl=True, hi=3, hi_incl=True),
+    "wall_model": Field("choice", "the floor: wall and dummy particle layers, or the analytic "
+                        "plane floor (no particles under the floor)", choices=WALL_MODELS),
 }
 
 RUNG_KEYS = {

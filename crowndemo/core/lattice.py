@@ -27,6 +27,11 @@ def potential_shape(r: np.ndarray, l0: float, re: float) -> np.ndarray:
     return np.where(r <= re, (r - 1.5 * l0 + 0.5 * re) * (r - re) ** 2 / 3.0, 0.0)
 
 
+def wall_layers(re_ratio: float) -> int:
+    """Layers of wall + dummy particles so that wall particles see a full neighbourhood (§5)."""
+    return int(math.ceil(re_ratio - 1e-9))
+
+
 def lattice_offsets(dim: int, l0: float, reach: float) -> np.ndarray:
     """All lattice vectors k*l0 (k integer, k != 0) with |k l0| < reach."""
     m = int(math.ceil(reach / l0))

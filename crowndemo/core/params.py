@@ -10,6 +10,7 @@ from dataclasses import dataclass, fields, replace
 from typing import Optional
 
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
+WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
 
 
 class ParameterError(ValueError):
@@ -85,6 +86,9 @@ class Numerics:
     neighbour_list: bool = True     # the density pass lists each fluid particle's neighbours
     #                                 for the pressure gradient (core/neighbours.py)
     cells_per_re: int = 2           # cells of side re/k, a walk over (2k + 1)^d cells (grid.py)
+    # the floor (z = 0): layers of wall and dummy particles, or the analytic plane floor
+    # (core/plane_floor.py: their contributions tabulated against the height; no particles)
+    wall_model: str = "particles"
 
     def validate(self, source: str = "parameters") -> "Numerics":
         def need(cond: bool, key: str, allowed: str):
@@ -105,6 +109,7 @@ class Numerics:
              "0 <= x < 1 (a fraction of l0; 0: off)")
         need(_finite(self.restitution) and 0 <= self.restitution <= 1, "restitution", "0 .. 1")
         need(isinstance(self.neighbour_list, bool), "neighbour_list", "true or false")
+        need(self.wall_model in WALL_MODELS, "wall_model", " | ".join(WALL_MODELS))
         need(isinstance(self.cells_per_re, int) and not isinstance(self.cells_per_re, bool)
              and 1 <= self.cells_per_re <= 3, "cells_per_re", "1, 2 or 3")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
@@ -126,18 +131,19 @@ class Model:
     collision: bool = False
     neighbour_list: bool = True
     cells_per_re: int = 2
+    plane_floor: bool = False
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
-                   numerics.cells_per_re)
+                   numerics.cells_per_re, numerics.wall_model == "plane")
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
                 "gravity": self.gravity, "pressure_gradient": self.pressure_gradient,
                 "collision": self.collision, "neighbour_list": self.neighbour_list,
-                "cells_per_re": self.cells_per_re}
+                "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor}
 
 
 def _finite(x) -> bool:
@@ -153,4 +159,5 @@ def with_values(obj, **changes):
     return replace(obj, **changes)
 
 
-__all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "with_values"]
+__all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "WALL_MODELS",
+           "with_values"]

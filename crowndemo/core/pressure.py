@@ -6,6 +6,8 @@ and the pressure-gradient corrector (S18-S20) in one of three forms (M2):
 - ``sum``:  (P_j + P_i), the momentum-conserving form of explicit MPS papers.
 """
 
+from typing import Optional
+
 import taichi as ti
 
 from .coefficients import Coefficients
@@ -13,6 +15,7 @@ from .grid import CellGrid
 from .neighbours import NeighbourList
 from .operators import gradient_pair, make_density_task, weight
 from .params import Model
+from .plane_floor import FLOOR_G, FLOOR_N, PlaneFloor
 from .state import DUMMY, FLUID, WALL
 
 
@@ -36,8 +39,10 @@ def _density_sums():
 
 @ti.data_oriented
 class Pressure:
-    def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
+    def __init__(self, model: Model, grid: CellGrid, coef: Coefficients,
+                 floor: Optional[PlaneFloor] = None):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
+        self.floor = floor          # the analytic plane floor when the model has one
         self.dim = model.dim
         self.sums = _gradient_sums(self.dim)
         self.density_sums = _density_sums()
@@ -55,6 +60,10 @@ class Pressure:
         acc.n += weight(ti.sqrt(r2), self.coef.re[None])
         if self.state.kind[j] != DUMMY:
             acc.count = self.neighbours.add(i, j, acc.count)
+
+    @ti.func
+    def _floor_density(self, z) -> float:
+        return self.floor.at(z)[FLOOR_N]
 
     @ti.kernel
     def density_and_pressure(self):
@@ -79,6 +88,10 @@ class Pressure:
                 else:
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._density_pair, n)
+                if ti.static(self.model.plane_floor):
+                    # the floor's wall and dummy layers (plane_floor.py), for fluid particles
+                    n += ti.select(k == FLUID,
+                                   self._floor_density(self.state.pos[i][self.dim - 1]), 0.0)
                 self.state.density[i] = n
                 self.state.pressure[i] = equation_of_state(n, n0, c2, rho, beta)
 
@@ -122,6 +135,18 @@ class Pressure:
                 if walk:
                     self.grid.for_each_neighbour(i, xi, self.coef.re2[None],
                                                  self._gradient_pair, acc)
+                if ti.static(self.model.plane_floor):
+                    # the floor's wall layer (S11 summed in plane_floor.py) at the pressure of a
+                    # hydrostatic mirror: P_i + rho g (depth of the layer below i)
+                    z = xi[self.dim - 1]
+                    g = ti.Vector.zero(float, self.dim)
+                    g[self.dim - 1] = self.floor.at(z)[FLOOR_G]
+                    p_wall = p_i
+                    if ti.static(self.model.gravity):
+                        p_wall -= self.coef.rho[None] * self.coef.gravity[None][self.dim - 1] * (
+                            z + self.floor.wall_depth[None])
+                    acc.pg += p_wall * g
+                    acc.g += g
                 p_ref = p_i
                 if ti.static(self.model.pressure_gradient == "pmin"):
                     p_ref = acc.pmin

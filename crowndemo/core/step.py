@@ -16,9 +16,10 @@ from . import timestep
 from .coefficients import Coefficients
 from .grid import CellGrid
 from .health import Health, HealthReport, InstabilityError, count_kinds
-from .lattice import LatticeConstants
+from .lattice import LatticeConstants, wall_layers
 from .operators import Operators
 from .params import Model, Numerics, Physics
+from .plane_floor import PlaneFloor
 from .pressure import Pressure
 from .state import FLUID, ParticleState
 from .terms import Predictor
@@ -86,8 +87,9 @@ class Simulator:
                              self.model.cells_per_re)
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
-        self.predictor = Predictor(self.model, self.grid, self.coef)
-        self.pressure = Pressure(self.model, self.grid, self.coef)
+        self.floor = PlaneFloor() if self.model.plane_floor else None   # else not allocated
+        self.predictor = Predictor(self.model, self.grid, self.coef, self.floor)
+        self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
         self.health = Health(self.state, self.coef)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
@@ -116,6 +118,8 @@ class Simulator:
         lo = [max(v, -big) for v in self.domain[0]]
         hi = [min(v, big) for v in self.domain[1]]
         self.coef.set(physics, numerics, self.lattice, lo, hi)
+        if self.floor is not None:
+            self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio))
 
     def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
         self.state.load(pos, vel, kind)
@@ -251,4 +255,4 @@ class Simulator:
 
     def memory_bytes(self) -> int:
         return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
-                + self.pressure.nbytes())
+                + self.pressure.nbytes() + (self.floor.nbytes() if self.floor else 0))

@@ -15,12 +15,15 @@ codes (Koshizuka, Nobe & Oka 1998; Lee et al. 2011, CMAME 200: 1113) removes the
 velocity of pairs closer than ``collision * l0`` before they collapse.
 """
 
+from typing import Optional
+
 import taichi as ti
 
 from .coefficients import Coefficients
 from .grid import CellGrid
 from .operators import laplacian_pair, weight
 from .params import Model
+from .plane_floor import FLOOR_V, PlaneFloor
 from .state import DUMMY, FLUID
 
 
@@ -34,8 +37,10 @@ def surface_tension_pair(rij, r, l0, re):
 
 @ti.data_oriented
 class Predictor:
-    def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
+    def __init__(self, model: Model, grid: CellGrid, coef: Coefficients,
+                 floor: Optional[PlaneFloor] = None):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
+        self.floor = floor          # the analytic plane floor when the model has one
         self.dim = model.dim
         self.pair_sums = ti.types.struct(visc=ti.types.vector(self.dim, float),
                                          st=ti.types.vector(self.dim, float))
@@ -99,6 +104,10 @@ class Predictor:
                                          st=ti.Vector.zero(float, self.dim))
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._pair, acc)
+                    if ti.static(self.model.plane_floor and self.model.viscosity):
+                        # the floor's wall layer, u_j = 0 (S12 summed in plane_floor.py)
+                        acc.visc -= self.state.vel[i] * self.floor.at(
+                            self.state.pos[i][self.dim - 1])[FLOOR_V]
                     a = ti.Vector.zero(float, self.dim)
                     if ti.static(self.model.viscosity):
                         a += visc * acc.visc
@@ -124,6 +133,13 @@ class Predictor:
                 du = ti.Vector.zero(float, self.dim)
                 self.grid.for_each_near(i, self.state.pos[i], self.coef.col_r2[None],
                                         self._collision_pair, du)
+                if ti.static(self.model.plane_floor):
+                    # against the floor's wall layer (the plane s = -l0/2), as against a wall
+                    # particle right below: the whole approach speed changes
+                    gap = self.state.pos[i][self.dim - 1] + self.floor.wall_depth[None]
+                    vn = self.state.vel[i][self.dim - 1]
+                    if gap < ti.sqrt(self.coef.col_r2[None]) and vn < 0.0:
+                        du[self.dim - 1] -= (1.0 + self.coef.col_e[None]) * vn
                 self.state.scratch_vec[i] = self.state.vel[i] + du
         for i in range(self.state.n[None]):
             if self.state.kind[i] == FLUID:

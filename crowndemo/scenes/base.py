@@ -7,6 +7,7 @@ from typing import Iterable, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ..core.lattice import wall_layers  # noqa: F401  (re-exported for the scene builders)
 from ..core.params import Numerics, Physics
 from ..core.state import DUMMY, FLUID, WALL
 
@@ -42,9 +43,18 @@ def lattice_block(lo: Sequence[float], hi: Sequence[float], l0: float) -> np.nda
     return np.stack([g.ravel() for g in grids], axis=1)
 
 
-def wall_layers(re_ratio: float) -> int:
-    """Layers of wall + dummy particles so that wall particles see a full neighbourhood (§5)."""
-    return int(math.ceil(re_ratio - 1e-9))
+def floor_face(dim: int) -> str:
+    """The floor's face: the plane z = 0 (y = 0 in 2D) under the liquid."""
+    return "z-" if dim == 3 else "y-"
+
+
+def particle_faces(faces: Iterable[str], dim: int, numerics: Optional[Numerics]) -> list:
+    """The faces built of particles: all of them, or without the floor when the numerics ask
+    for the analytic plane floor (core/plane_floor.py)."""
+    faces = list(faces)
+    if numerics is not None and numerics.wall_model == "plane":
+        faces = [f for f in faces if f != floor_face(dim)]
+    return faces
 
 
 def container_walls(inner_lo: Sequence[float], inner_hi: Sequence[float], l0: float,

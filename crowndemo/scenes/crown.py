@@ -14,7 +14,8 @@ from typing import Optional
 import numpy as np
 
 from ..core.params import Numerics, Physics
-from .base import Scene, assemble, container_walls, lattice_block, wall_layers
+from .base import (Scene, assemble, container_walls, floor_face, lattice_block, particle_faces,
+                   wall_layers)
 
 
 def crown_base_radius(t: float, U: float, D: float, h: float) -> float:
@@ -62,14 +63,15 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     vel[len(film_pts):, -1] = -speed
     # walls: the floor under the film; side walls only if the liquid can reach them
     layers = wall_layers(re_ratio)
-    faces = ["z-"] if dim == 3 else ["y-"]
+    faces = [floor_face(dim)]
     if not trimmed:
         faces += ["x-", "x+"] + (["y-", "y+"] if dim == 3 else [])
+    faces = particle_faces(faces, dim, numerics)
     wall_top = film + 0.5 * drop
     floor_lo = [-extent - (0 if not trimmed else layers * l0)] * (dim - 1) + [0.0]
     floor_hi = [extent + (0 if not trimmed else layers * l0)] * (dim - 1) + [wall_top]
-    walls = container_walls(floor_lo, floor_hi, l0, layers, faces)
-    if trimmed and dim == 3:   # only the disc under the film (and a rim of `layers` l0)
+    walls = container_walls(floor_lo, floor_hi, l0, layers, faces) if faces else None
+    if walls is not None and trimmed and dim == 3:   # the disc under the film, a rim `layers` wide
         keep = np.linalg.norm(walls[0][:, :2], axis=1) <= extent + layers * l0
         walls = (walls[0][keep], walls[1][keep])
     margin = (layers + 1) * l0
@@ -81,6 +83,8 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
         left_out.append(f"film beyond r = {extent * 1e3:.1f} mm (of {half * 1e3:.0f} mm): the "
                         "impact cannot disturb it before t_end; its edge is free")
         left_out.append("side walls: the liquid cannot reach them before t_end")
+    if floor_face(dim) not in faces:
+        left_out.append("floor particles: the analytic plane floor stands for them")
     if sigma == 0:
         left_out.append("surface tension term (sigma = 0)")
     if nu == 0:

@@ -8,7 +8,7 @@ from typing import Optional
 import numpy as np
 
 from ..core.params import Numerics, Physics
-from .base import Scene, assemble, container_walls, lattice_block, wall_layers
+from .base import Scene, assemble, container_walls, lattice_block, particle_faces, wall_layers
 
 WATER = dict(rho=998.0, nu=1.0e-6, sigma=0.0728)
 
@@ -31,11 +31,12 @@ def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, dept
     inner_hi = [width] * (dim - 1) + [depth + max(4 * l0, 0.25 * depth)]
     fluid = lattice_block([0.0] * dim, [width] * (dim - 1) + [depth], l0)
     layers = wall_layers(ph.re_ratio)
-    walls = container_walls([0.0] * dim, inner_hi, l0, layers, _walls_faces(dim))
+    faces = particle_faces(_walls_faces(dim), dim, numerics)
+    walls = container_walls([0.0] * dim, inner_hi, l0, layers, faces)
     margin = (layers + 1) * l0
     domain = (tuple([-margin] * dim), tuple([width + margin] * (dim - 1) + [3.0 * depth]))
     info = {"scene": "hydrostatic tank", "width_m": width, "depth_m": depth,
-            "walls": _walls_faces(dim), "wall_top_m": inner_hi[-1]}
+            "walls": faces, "wall_top_m": inner_hi[-1]}
     return assemble("tank", ph, numerics or Numerics(), fluid, None, walls, domain, t_end, info)
 
 
@@ -51,12 +52,13 @@ def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float =
     fluid = lattice_block([0.0] * dim, [a] + across + [2.0 * a], l0)
     inner_hi = [length * a] + across + [2.5 * a]
     layers = wall_layers(ph.re_ratio)
-    walls = container_walls([0.0] * dim, inner_hi, l0, layers, _walls_faces(dim))
+    faces = particle_faces(_walls_faces(dim), dim, numerics)
+    walls = container_walls([0.0] * dim, inner_hi, l0, layers, faces)
     margin = (layers + 1) * l0
     domain = (tuple([-margin] * dim),
               tuple([length * a + margin] + [channel * a + margin] * (dim - 2) + [6.0 * a]))
     info = {"scene": "dam break", "a_m": a, "length_a": length, "channel_a": channel,
-            "walls": _walls_faces(dim), "wall_top_m": inner_hi[-1]}
+            "walls": faces, "wall_top_m": inner_hi[-1]}
     return assemble("dam-break", ph, numerics or Numerics(), fluid, None, walls, domain, t_end,
                     info)
 

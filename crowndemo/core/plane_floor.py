@@ -1,0 +1,92 @@
+"""Analytic plane floor (method.md §5 walls, as distance tables): the wall and dummy layers
+under a flat floor replaced by their contributions, tabulated on the host against the height s
+of a fluid particle above the floor surface (the plane z = 0 of the last axis, where every
+scene builder puts its floor).
+
+The layers it stands for are the ones the scene builders lay (scenes/base.py): the fluid
+lattice continued below the surface, wall particles at s = -l0/2 and ``layers - 1`` dummy
+layers under them. The tables are summed for a particle right above a column of that lattice,
+so a fluid lattice at rest sees exactly the number density it would see with the particles;
+a particle between columns sees the same values (the particle floor's lateral ripple is left
+out). Per height s, three sums over the layers' points j within re:
+
+- n_floor(s) = sum over every layer of w(r)                 -> number density (S9)
+- g_floor(s) = sum over the wall layer of (z_j - z_i) w / r^2 -> pressure gradient (S11), the
+  floor's wall particles at the pressure of a hydrostatic mirror, P_i + rho g (s + l0/2)
+  (P_i without gravity): with P_j = P_i the floor pushed too little and the 2D tank's floor
+  pressure read 6.6 % low
+- v_floor(s) = sum over the wall layer of w(r)              -> viscosity (S12), u_j = 0
+
+and a particle closer than the collision distance to the wall layer's plane loses its
+approach speed as against a wall particle (the collision model, terms.py).
+"""
+from __future__ import annotations
+
+import math
+from typing import Tuple
+
+import numpy as np
+import taichi as ti
+
+from .lattice import weight
+
+SAMPLES = 1024
+FLOOR_N, FLOOR_G, FLOOR_V = 0, 1, 2
+
+
+def floor_tables(dim: int, l0: float, re: float, layers: int,
+                 samples: int = SAMPLES) -> Tuple[float, float, np.ndarray]:
+    """(s0, ds, table[samples, 3]): n_floor, g_floor (the component along the last axis) and
+    v_floor at s = s0 + k ds, from s0 = -l0/4 (closer, the collision model has acted; the
+    table holds its last value) to re - l0/2 (beyond, no floor point is within re)."""
+    s0, s1 = -0.25 * l0, re - 0.5 * l0
+    ds = (s1 - s0) / (samples - 1)
+    m = int(math.ceil(re / l0))
+    lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
+    lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
+    lat2 = (lateral ** 2).sum(axis=1)
+    table = np.zeros((samples, 3))
+    for k in range(samples):
+        s = s0 + k * ds
+        for layer in range(layers):
+            dz = -(layer + 0.5) * l0 - s                           # z_j - z_i
+            r = np.sqrt(lat2 + dz * dz)
+            w = weight(r, re)
+            table[k, FLOOR_N] += w.sum()
+            if layer == 0:
+                table[k, FLOOR_G] += (dz / (r * r) * w).sum()
+                table[k, FLOOR_V] += w.sum()
+    return s0, ds, table
+
+
+@ti.data_oriented
+class PlaneFloor:
+    def __init__(self):
+        self.table = ti.Vector.field(3, float, SAMPLES)
+        self.s0 = ti.field(float, shape=())
+        self.inv_ds = ti.field(float, shape=())
+        self.wall_depth = ti.field(float, shape=())    # the wall layer's plane: s = -l0/2
+
+    def set(self, dim: int, l0: float, re: float, layers: int) -> None:
+        s0, ds, table = floor_tables(dim, l0, re, layers)
+        self.s0[None] = s0
+        self.inv_ds[None] = 1.0 / ds
+        self.wall_depth[None] = 0.5 * l0
+        fdt = np.float64 if ti.lang.impl.current_cfg().default_fp == ti.f64 else np.float32
+        self.table.from_numpy(table.astype(fdt))
+
+    def nbytes(self) -> int:
+        from .state import field_nbytes
+        return field_nbytes(self.table)
+
+    @ti.func
+    def at(self, s):
+        """(n_floor, g_floor, v_floor) at height s, linear between samples; zero past the top."""
+        x = (ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None]
+        row = ti.min(ti.cast(ti.floor(x), ti.i32), SAMPLES - 1)
+        frac = ti.min(x - row, 1.0)
+        upper = ti.min(row + 1, SAMPLES - 1)      # the last sample is zero: zero past it
+        return (1.0 - frac) * self.table[row] + frac * self.table[upper]
+
+
+__all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V"]
