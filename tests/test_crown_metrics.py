@@ -114,3 +114,19 @@ def test_count_jets_on_a_profile():
     theta = np.linspace(0, 2 * math.pi, 200, endpoint=False)
     assert count_jets(np.cos(7 * theta), 0.5) == 7
     assert count_jets(0.1 * np.cos(7 * theta), 0.5) == 0
+
+
+def test_a_trimmed_films_raised_edge_is_not_the_crown():
+    """A crown wall at 3 mm on a film cut at 8 mm whose free edge has risen 5 l0: without
+    ``edge`` the rule takes the edge for the crown's foot (the 3m-drop booth run at 4 ms);
+    with the film's edge given (crown_metrics.film_edge) it measures the wall."""
+    from crowndemo.validate.crown_metrics import film_edge
+    R, T, top = 3.0e-3, 4 * L0, H + 2.0e-3
+    extent = 8.0e-3
+    edge_ring = shell(extent - 2 * L0, 4 * L0, lambda t: H + 5 * L0)
+    pts = np.concatenate([film(extent), shell(R, T, lambda t: top), edge_ring])
+    fooled = measure(pts, 1e-3, H, D, L0)
+    assert fooled.base_radius > extent - 3 * L0
+    m = measure(pts, 1e-3, H, D, L0, edge=film_edge(extent, L0))
+    assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
+    assert m.rim_height == pytest.approx(top - H, abs=L0) and m.crown

@@ -39,8 +39,9 @@ def run(preset: str, films: Sequence[float], speeds: Sequence[float], quality: s
     points = []
     for r in resolved:
         t0 = time.perf_counter()
-        sim = session.load(r.build_scene())
-        m, outcome = run_and_measure(sim, r)
+        scene = r.build_scene()
+        sim = session.load(scene)
+        m, outcome = run_and_measure(sim, r, scene.info)
         p = Point(r.scene["film"], r.speed, m.crown if outcome == "ran to the end" else None,
                   m.rim_height, m.base_radius, sim.stats.steps, time.perf_counter() - t0,
                   outcome)

@@ -13,7 +13,7 @@ from typing import Callable, Iterable, List, Optional, Tuple
 
 from .. import config
 from ..core import FLUID, InstabilityError, simulator_for
-from .crown_metrics import CrownMetrics, measure
+from .crown_metrics import CrownMetrics, film_edge, measure
 
 # preset -> what the seed saw
 SEED = {"3m-drop": True, "2.5m-drop": True, "20cm-drop": False, "thick-layer": False}
@@ -69,9 +69,11 @@ class Verdict:
         return [o["time"] for o in self.series or [] if o["crown"]]
 
 
-def run_and_measure(sim, resolved) -> Tuple[CrownMetrics, str]:
+def run_and_measure(sim, resolved, scene_info: Optional[dict] = None
+                    ) -> Tuple[CrownMetrics, str]:
     """Run a loaded simulator to the preset's end time (or until it goes unstable) and measure
-    the crown at the last time reached; returns the metrics and the outcome."""
+    the crown at the last time reached (``scene_info``: the scene's, for a trimmed film's
+    edge); returns the metrics and the outcome."""
     outcome = "ran to the end"
     try:
         sim.run(resolved.t_end)
@@ -80,19 +82,28 @@ def run_and_measure(sim, resolved) -> Tuple[CrownMetrics, str]:
     snap = sim.snapshot()
     s = resolved.scene
     return measure(snap["pos"][snap["kind"] == FLUID], sim.stats.time, s["film"], s["drop"],
-                   resolved.l0), outcome
+                   resolved.l0, edge=_edge(scene_info, resolved.l0)), outcome
 
 
-def run_and_observe(sim, resolved) -> Tuple[List[CrownMetrics], str]:
+def _edge(scene_info: Optional[dict], l0: float) -> Optional[float]:
+    """The trimmed film's free edge, from the info of the scene the simulator was loaded with."""
+    info = scene_info or {}
+    if not info.get("trimmed"):
+        return None
+    return film_edge(info.get("extent_m"), l0)
+
+
+def run_and_observe(sim, resolved, scene_info: Optional[dict] = None) -> Tuple[List[CrownMetrics], str]:
     """Run to the preset's end time (or until it goes unstable), measuring the crown at each
     of ``observation_times`` reached, and at the last time when it stopped early."""
     s = resolved.scene
     seen: List[CrownMetrics] = []
+    edge = _edge(scene_info, resolved.l0)
 
     def observe(sim_, i):
         snap = sim_.snapshot()
         seen.append(measure(snap["pos"][snap["kind"] == FLUID], sim_.stats.time, s["film"],
-                            s["drop"], resolved.l0))
+                            s["drop"], resolved.l0, edge=edge))
     outcome = "ran to the end"
     try:
         sim.run(resolved.t_end, frame_times=observation_times(resolved.t_end),
@@ -109,7 +120,7 @@ def run_preset(preset: str, quality: str = "draft", sets: Iterable[str] = ()) ->
     t0 = time.perf_counter()
     scene = r.build_scene()
     sim = simulator_for(scene)
-    seen, outcome = run_and_observe(sim, r)
+    seen, outcome = run_and_observe(sim, r, scene.info)
     crowned = [m for m in seen if m.crown]
     m = crowned[0] if crowned else seen[-1]      # the first crown, else the last look
     seed = SEED.get(r.name)
