@@ -7,6 +7,7 @@ import pytest
 from crowndemo import backend, config
 from crowndemo.control import HEADROOM, Session, compiled_kernels
 from crowndemo.core import simulator_for
+from crowndemo.core.step import capacity_bucket
 
 SHORT = ["scene.t_end=6e-5", "scene.frame_interval=3e-5"]         # the drop touches the film at 0.05 ms (U = 8 m/s)
 
@@ -57,7 +58,7 @@ def test_bigger_scene_reallocates_once_with_headroom(one_thread):
     session.load(small)
     sim = session.load(big)
     assert session.constructions == 2 and session.reallocations == 1
-    assert sim.state.capacity == int(np.ceil(HEADROOM * len(big.pos)))
+    assert sim.state.capacity == capacity_bucket(int(np.ceil(HEADROOM * len(big.pos))))
     assert session.load(small) is sim and session.constructions == 2   # fits: reused
     assert sim.state.count == len(small.pos)
 
@@ -68,3 +69,16 @@ def test_models_get_their_own_simulators(one_thread):
     session = Session()
     sa, sb = session.load(a), session.load(b)
     assert sa is not sb and session.simulators == 2 and sb.model.viscosity is False
+
+
+def test_capacity_buckets_share_compiled_kernels():
+    """Capacities come in steps of 2^(1/4) from 1024 (at most 19 % unused): sizes within a step
+    get the same field shapes, which Taichi's offline cache keys the compiled kernels on."""
+    sizes = [1, 1024, 1025, 5000, 290_000, 300_000, 386_470, 15_548_809]
+    for n in sizes:
+        c = capacity_bucket(n)
+        assert n <= c <= max(1024, 1.19 * n + 1)
+        assert capacity_bucket(c) == c                      # a bucket is its own bucket
+    assert capacity_bucket(290_000) == capacity_bucket(300_000)
+    buckets = [capacity_bucket(n) for n in range(1000, 200_000, 997)]
+    assert buckets == sorted(buckets) and len(set(buckets)) < 30

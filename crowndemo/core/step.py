@@ -66,6 +66,19 @@ class RunStats:
                            "left_domain": dict(h.left), "nonfinite": h.nonfinite}}
 
 
+CAPACITY_STEP = 2.0 ** 0.25     # capacities are 1024 x 2^(k/4): at most 19 % unused
+
+
+def capacity_bucket(particles: int) -> int:
+    """The capacity allocated for ``particles``: the next of 1024, 1024 x 2^(1/4), ... Field
+    shapes are part of Taichi's offline-cache key, so scenes whose sizes fall in one bucket
+    load each other's compiled kernels (a first step of ~5 s instead of ~36 s, BENCHMARKS.md)."""
+    c = 1024
+    while c < particles:
+        c = int(math.ceil(c * CAPACITY_STEP))
+    return c
+
+
 def default_max_cells(particles: int) -> int:
     """The cell grid's size limit for a number of particles (the cell side grows past it)."""
     return max(2 * particles, 4096)
@@ -73,7 +86,8 @@ def default_max_cells(particles: int) -> int:
 
 class Simulator:
     """Holds one compiled step. ``configure`` changes run-time values without recompiling;
-    the compiled terms (``Model``) are fixed at construction."""
+    the compiled terms (``Model``) are fixed at construction. Room for at least ``capacity``
+    particles (``capacity_bucket`` of it)."""
 
     def __init__(self, physics: Physics, numerics: Numerics, capacity: int,
                  max_cells: Optional[int] = None):
@@ -81,6 +95,7 @@ class Simulator:
         numerics.validate()
         self.model = Model.of(physics, numerics)
         dim = physics.dim
+        capacity = capacity_bucket(capacity)
         self.state = ParticleState(dim, capacity)
         self._auto_cells = max_cells is None    # then the cell limit follows the particles
         self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity),
