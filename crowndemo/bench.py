@@ -36,7 +36,8 @@ read-back to the host that picks the next dt.
 - `particle-steps/s` = fluid particles x timed steps / seconds.
 - The first steps are not timed: they compile the kernels (or load them from Taichi's offline
   cache, so a repeat run shows a smaller `compile s`). `compile s` = first step - a normal step.
-- `bytes/particle` = `Simulator.memory_bytes()` / total particles (particle fields + cell grid).
+- `bytes/particle` = `Simulator.memory_bytes()` / total particles (particle fields, cell grid,
+  neighbour list; allocated for the capacity bucket, `core.step.capacity_bucket`).
 
 Sections are appended by `crowndemo bench --record`, newest last.
 """

@@ -24,7 +24,8 @@ in a 3D tank with walls. particle-steps/s = fluid particles x steps / seconds; t
 (JIT compile) are not timed and are reported as compile_s. Then 5 more steps are timed stage by
 stage (grid, predictor, collision, density, corrector, health; each stage waits for the device,
 so their sum is a little over a normal step). bytes/particle: the simulator's fields (particles,
-cell grid, neighbour list) over all particles, walls included.
+cell grid, neighbour list), allocated for a capacity rounded up to the next 2^(1/4) step, over
+the particles in use, walls included.
 
 --compare runs each N twice in one process: "seed" is the seed's formulation with a plain
 implementation (gradient P_j - P_i, no collision model, cells of side re, no neighbour list, no
