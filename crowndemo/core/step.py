@@ -192,12 +192,7 @@ class Simulator:
         if self.predictor.needs_neighbours:
             self.grid.build(re, reorder=reorder)        # neighbours at r^k
             self._stage("grid")
-        self.predictor.accelerate(dt)                   # S14-S15
-        self._stage("predictor")
-        if self.model.collision:
-            self.predictor.collide()
-            self._stage("collision")
-        self.predictor.move(dt)                         # S16
+        self.predictor.run(dt, mark=self._stage)        # S14-S16
         self.grid.build(re, reorder=reorder and not self.predictor.needs_neighbours)  # at r*
         self._stage("grid")
         self.pressure.density_and_pressure()            # S17 (M3)

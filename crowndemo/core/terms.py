@@ -15,7 +15,7 @@ codes (Koshizuka, Nobe & Oka 1998; Lee et al. 2011, CMAME 200: 1113) removes the
 velocity of pairs closer than ``collision * l0`` before they collapse.
 """
 
-from typing import Optional
+from typing import Callable, Optional
 
 import taichi as ti
 
@@ -84,12 +84,15 @@ class Predictor:
                     acc.st += surface_tension_pair(rij, r, self.coef.l0[None],
                                                    self.coef.re[None])
 
-    def run(self, dt: float) -> None:
+    def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None) -> None:
         """u* = u + dt a* (S15), the collision model on u* at r^k, r* = r + dt u* (S16),
-        a* from (S14)."""
+        a* from (S14). ``mark(stage)`` is called as the "predictor" and "collision" stages end
+        (the simulator's stage timer)."""
         self.accelerate(dt)
+        mark("predictor")
         if self.model.collision:
             self.collide()
+            mark("collision")
         self.move(dt)
 
     @ti.kernel

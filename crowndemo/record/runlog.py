@@ -1,6 +1,6 @@
 """The bookkeeping of one recording that is not in the simulator: the frames written, wall
-times and the starts (a resumed run adds one); health peaks are in the simulator's RunStats. Saved inside the checkpoint, so a
-resumed run continues it."""
+times and the starts (a resumed run adds one); health peaks are in the simulator's RunStats.
+Saved inside the checkpoint, so a resumed run continues it."""
 from __future__ import annotations
 
 import time

@@ -69,22 +69,6 @@ class Verdict:
         return [o["time"] for o in self.series or [] if o["crown"]]
 
 
-def run_and_measure(sim, resolved, scene_info: Optional[dict] = None
-                    ) -> Tuple[CrownMetrics, str]:
-    """Run a loaded simulator to the preset's end time (or until it goes unstable) and measure
-    the crown at the last time reached (``scene_info``: the scene's, for a trimmed film's
-    edge); returns the metrics and the outcome."""
-    outcome = "ran to the end"
-    try:
-        sim.run(resolved.t_end)
-    except InstabilityError as e:
-        outcome = f"stopped: {e.what} at t = {e.time * 1e3:.4g} ms"
-    snap = sim.snapshot()
-    s = resolved.scene
-    return measure(snap["pos"][snap["kind"] == FLUID], sim.stats.time, s["film"], s["drop"],
-                   resolved.l0, edge=_edge(scene_info, resolved.l0)), outcome
-
-
 def _edge(scene_info: Optional[dict], l0: float) -> Optional[float]:
     """The trimmed film's free edge, from the info of the scene the simulator was loaded with."""
     info = scene_info or {}
@@ -93,9 +77,11 @@ def _edge(scene_info: Optional[dict], l0: float) -> Optional[float]:
     return film_edge(info.get("extent_m"), l0)
 
 
-def run_and_observe(sim, resolved, scene_info: Optional[dict] = None) -> Tuple[List[CrownMetrics], str]:
+def run_and_observe(sim, resolved, scene_info: Optional[dict] = None,
+                    times: Optional[List[float]] = None) -> Tuple[List[CrownMetrics], str]:
     """Run to the preset's end time (or until it goes unstable), measuring the crown at each
-    of ``observation_times`` reached, and at the last time when it stopped early."""
+    of ``times`` reached (default ``observation_times``), and at the last time when it
+    stopped early. ``scene_info``: the scene's, for a trimmed film's edge."""
     s = resolved.scene
     seen: List[CrownMetrics] = []
     edge = _edge(scene_info, resolved.l0)
@@ -106,12 +92,20 @@ def run_and_observe(sim, resolved, scene_info: Optional[dict] = None) -> Tuple[L
                             s["drop"], resolved.l0, edge=edge))
     outcome = "ran to the end"
     try:
-        sim.run(resolved.t_end, frame_times=observation_times(resolved.t_end),
-                on_frame=observe)
+        sim.run(resolved.t_end, on_frame=observe,
+                frame_times=observation_times(resolved.t_end) if times is None else times)
     except InstabilityError as e:
         outcome = f"stopped: {e.what} at t = {e.time * 1e3:.4g} ms"
         observe(sim, -1)
     return seen, outcome
+
+
+def run_and_measure(sim, resolved, scene_info: Optional[dict] = None
+                    ) -> Tuple[CrownMetrics, str]:
+    """``run_and_observe`` with one look, at the last time reached; returns those metrics and
+    the outcome."""
+    seen, outcome = run_and_observe(sim, resolved, scene_info, times=[resolved.t_end])
+    return seen[-1], outcome
 
 
 def run_preset(preset: str, quality: str = "draft", sets: Iterable[str] = ()) -> Verdict:
