@@ -125,14 +125,98 @@ def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
         "first_step_s": warm[0],
         "setup_s": setup_s,
         "stage_ms": stage_ms,
-        "arch": be.arch,
-        "resolved_arch": be.resolved,
-        "precision": be.precision,
-        "single_thread": be.single_thread,
-        "bytes_per_particle": sim.memory_bytes() / total,
-        "memory_bytes": sim.memory_bytes(),
+        **_backend_and_memory(be, sim),
         "dt_s": sim.stats.dt_max,
     }
+
+
+def _backend_and_memory(be, sim) -> Dict:
+    """The result fields every benchmark shares: where it ran, and the simulator's bytes."""
+    total = sim.state.count
+    return {"arch": be.arch, "resolved_arch": be.resolved, "precision": be.precision,
+            "single_thread": be.single_thread,
+            "bytes_per_particle": sim.memory_bytes() / total, "memory_bytes": sim.memory_bytes()}
+
+
+def run_preset(resolved, stages: bool = True, max_steps: Optional[int] = None,
+               progress=None) -> Dict:
+    """Run a resolved preset (``crowndemo.config.load``) to its end time, as ``crowndemo run``
+    does without recording, and time it: ``run_s`` is the whole wall time (scene set-up, the
+    first step that compiles or loads the kernels, every step to t_end), ``seconds`` the steps
+    after the first. With ``stages`` every step after the first is timed stage by stage
+    (``stage_ms``, per step). ``max_steps`` stops early (a smoke test; ``simulated_s`` says
+    how far it got). ``progress(sim)`` is called after every step."""
+    import taichi as ti
+
+    from . import backend
+    from .core import simulator_for
+
+    be = backend.current()
+    t0 = time.perf_counter()
+    scene = resolved.build_scene()
+    sim = simulator_for(scene)
+    ti.sync()
+    setup_s = time.perf_counter() - t0
+    t = time.perf_counter()
+    sim.step()
+    ti.sync()
+    first_s = time.perf_counter() - t
+    if progress:
+        progress(sim)
+    if stages:
+        sim.time_stages()
+
+    def on_step(s):
+        if progress:
+            progress(s)
+        if max_steps is not None and s.stats.steps >= max_steps:
+            raise _Enough
+
+    t = time.perf_counter()
+    try:
+        sim.run(resolved.t_end, on_step=on_step)
+    except _Enough:
+        pass
+    ti.sync()
+    seconds = time.perf_counter() - t
+    run_s = time.perf_counter() - t0
+    steps = sim.stats.steps - 1
+    stage_ms = None
+    if stages and steps > 0:
+        stage_ms = {name: 1e3 * v / steps for name, v in sim.stage_seconds.items() if v}
+        sim.time_stages(False)
+    counts = sim.counts()
+    fluid, total = sim.n_fluid, sim.state.count
+    per_step = seconds / steps if steps else math.inf
+    stats = sim.stats
+    return {
+        "label": f"{resolved.name} {resolved.quality}",
+        "preset": resolved.name,
+        "quality": resolved.quality,
+        "model": sim.model.describe(),
+        "l0_m": resolved.l0,
+        "t_end_s": resolved.t_end,
+        "simulated_s": stats.time,
+        "particles": {"fluid": fluid, "total": total, "wall": counts.get("wall", 0),
+                      "dummy": counts.get("dummy", 0), "gone": counts.get("gone", 0)},
+        "steps": int(stats.steps),
+        "binding_limits": dict(stats.binding),
+        "run_s": run_s,
+        "seconds": seconds,
+        "seconds_per_step": per_step,
+        "particle_steps_per_s": fluid * steps / seconds if seconds > 0 else math.inf,
+        "compile_s": max(first_s - per_step, 0.0) if steps else first_s,
+        "first_step_s": first_s,
+        "setup_s": setup_s,
+        "startup_s": setup_s + first_s,
+        "stage_ms": stage_ms,
+        **_backend_and_memory(be, sim),
+        "cells": int(sim.grid.num_cells[None]),
+    }
+
+
+class _Enough(Exception):
+    """Raised from the step callback to stop a preset run at ``max_steps``."""
 
 
 def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
@@ -153,6 +237,22 @@ def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = 
 # ---- output ----------------------------------------------------------------------------------
 COLUMNS = ("fluid", "total", "steps", "seconds", "particle-steps/s", "compile s", "bytes/particle",
            "arch", "precision")
+# a preset run to its end time: the wall time the user waits, and how it splits
+PRESET_COLUMNS = ("preset", "fluid", "total", "steps", "simulated ms", "to t_end s", "start-up s",
+                  "particle-steps/s", "bytes/particle", "arch", "precision")
+
+
+def _preset_row(r: Dict) -> List[str]:
+    arch = r["arch"] if r["arch"] == r["resolved_arch"] else f"{r['arch']} ({r['resolved_arch']})"
+    return [r["label"], f"{r['particles']['fluid']:,}", f"{r['particles']['total']:,}",
+            str(r["steps"]), f"{1e3 * r['simulated_s']:.3g} of {1e3 * r['t_end_s']:.3g}",
+            f"{r['run_s']:.1f}", f"{r['startup_s']:.1f}", f"{r['particle_steps_per_s']:.3e}",
+            f"{r['bytes_per_particle']:.0f}", arch,
+            r["precision"] + (" 1-thread" if r["single_thread"] else "")]
+
+
+def _presets(results: Sequence[Dict]) -> bool:
+    return any("preset" in r for r in results)
 
 
 def _row(r: Dict) -> List[str]:
@@ -167,8 +267,15 @@ def _labelled(results: Sequence[Dict]) -> bool:
     return any(r.get("label", "tuned") != "tuned" for r in results)
 
 
+def _label_head(results: Sequence[Dict]) -> str:
+    return "preset" if _presets(results) else "variant"
+
+
 def _rows(results: Sequence[Dict]) -> List[List[str]]:
-    """The main table: a ``variant`` column first when results compare formulations."""
+    """The main table: a ``variant`` column first when results compare formulations; preset
+    runs have their own columns (PRESET_COLUMNS)."""
+    if _presets(results):
+        return [list(PRESET_COLUMNS)] + [_preset_row(r) for r in results]
     head = list(COLUMNS)
     rows = [_row(r) for r in results]
     if _labelled(results):
@@ -183,7 +290,8 @@ def stage_rows(results: Sequence[Dict]) -> List[List[str]]:
     timed = [r for r in results if r.get("stage_ms")]
     if not timed:
         return []
-    head = (["variant"] if _labelled(results) else []) + ["fluid"] + list(STAGES) + ["sum"]
+    head = ([_label_head(results)] if _labelled(results) else []) + ["fluid"] + list(STAGES) \
+        + ["sum"]
     rows = [head]
     for r in timed:
         ms = r["stage_ms"]
@@ -200,7 +308,8 @@ def comparison_lines(results: Sequence[Dict]) -> List[str]:
     lines = []
     by_n: Dict[int, Dict[str, Dict]] = {}
     for r in results:
-        by_n.setdefault(r["n_requested"], {})[r.get("label", "tuned")] = r
+        if "n_requested" in r:      # a tank block (not a preset run)
+            by_n.setdefault(r["n_requested"], {})[r.get("label", "tuned")] = r
     for n, pair in by_n.items():
         if "seed" in pair and "tuned" in pair:
             ratio = pair["tuned"]["particle_steps_per_s"] / pair["seed"]["particle_steps_per_s"]
@@ -245,8 +354,10 @@ def markdown_table(results: Sequence[Dict]) -> str:
     rows, right, stages, stage_right, ratios = _tables(results)
     out = _markdown(rows, right)
     if stages:
-        out += (f"\n\nTime per step by stage, ms (share), from {STAGE_STEPS} more steps timed "
-                "stage by stage:\n\n" + _markdown(stages, stage_right))
+        how = ("over every step after the first" if _presets(results) else
+               f"from {STAGE_STEPS} more steps timed stage by stage")
+        out += f"\n\nTime per step by stage, ms (share), {how}:\n\n" + _markdown(stages,
+                                                                                   stage_right)
     if ratios:
         out += "\n\n" + "\n".join(f"- {line}" for line in ratios)
     return out

@@ -50,6 +50,11 @@ def test_info_table(capsys):
     (["scene", "dam-break", "--dim", "2", "--a", "-0.1"], "a"),
     (["scene", "tank", "--a", "0.1"], "--a"),
     (["bench", "--n", "0"], "n"),
+    (["bench", "--set", "scene.speed=3"], "--preset"),
+    (["bench", "--preset", "quick", "--n", "1000"], "--preset"),
+    (["bench", "--preset", "nosuch-preset"], "nosuch-preset"),
+    (["bench", "--preset", "quick", "--set", "scene.speed=-1"], "scene.speed"),
+    (["bench", "--preset", "quick", "--max-steps", "0"], "max-steps"),
     (["nosuch"], "nosuch"),
 ])
 def test_bad_input_exits_2_with_one_line(argv, key, capsys):
@@ -79,6 +84,22 @@ def test_bench_json(capsys):
     assert data["compile_s"] >= 0
     assert data["bytes_per_particle"] > 0
     assert data["precision"] == "f32"
+
+
+def test_bench_preset_json(capsys):
+    from crowndemo.core.step import STAGES
+    assert main(["bench", "--preset", "quick", "--quality", "draft", "--max-steps", "3",
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["preset"] == "quick" and data["quality"] == "draft"
+    assert data["steps"] == 3 and 0 < data["simulated_s"] < data["t_end_s"]
+    # the whole wall time holds the set-up, the first step and the timed steps
+    assert data["run_s"] >= data["setup_s"] + data["first_step_s"] + data["seconds"] - 1e-3
+    assert data["startup_s"] == pytest.approx(data["setup_s"] + data["first_step_s"])
+    assert data["particle_steps_per_s"] == pytest.approx(
+        data["particles"]["fluid"] * 2 / data["seconds"])
+    assert set(data["stage_ms"]) <= set(STAGES) and data["stage_ms"]["density"] > 0
+    assert data["particles"]["total"] > data["particles"]["fluid"] > 10_000
 
 
 def test_scene_dam_break_2d(capsys):

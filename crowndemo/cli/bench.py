@@ -8,7 +8,8 @@ import sys
 from typing import Sequence
 
 from ..core.params import ParameterError
-from .common import (PROG, Fmt, repo_root, start_backend)
+from ..config.schema import QUALITIES
+from .common import PROG, Fmt, Progress, repo_root, start_backend
 
 
 BENCH_EPILOG = """\
@@ -18,6 +19,8 @@ examples:
   crowndemo bench --arch cuda --n 1000000     # on an NVIDIA GPU
   crowndemo bench --record                    # append the results to BENCHMARKS.md
   crowndemo bench --compare --n 100000        # the seed's formulation against the tuned one
+  crowndemo bench --preset 3m-drop            # the 3m-drop preset at booth quality to its end
+  crowndemo bench --preset 2.5m-drop --quality seed --arch cuda --record   # on a GPU
 
 The scene is a k x k x kz block of water (k = round(N^(1/3)), l0 = 1 mm, re = 2.1 l0) resting
 in a 3D tank with walls. particle-steps/s = fluid particles x steps / seconds; the first steps
@@ -31,12 +34,23 @@ the particles in use, walls included.
 implementation (gradient P_j - P_i, no collision model, cells of side re, no neighbour list, no
 re-sort); "tuned" is the project's default (pmin gradient, collisions, cells of side re/2, the
 neighbour list, re-sort every step). It prints tuned / seed.
+
+--preset runs presets to their end time instead (as `crowndemo run`, nothing recorded), at
+--quality (default booth) with --set overrides: "to t_end s" is the whole wall time (scene
+set-up, the first step, which compiles or loads the kernels, and every step), "start-up s" its
+set-up and first step; particle-steps/s counts fluid particles over the steps after the first,
+which are also timed stage by stage (the stage timer waits for the device after each stage).
 """
 
 
 def _bench(args, argv: Sequence[str]) -> int:
     from .. import bench
 
+    if args.preset:
+        return _bench_presets(args, argv)
+    if args.sets or args.quality or args.max_steps is not None:
+        raise ParameterError("--set/--quality/--max-steps", "given",
+                             "only with --preset (the tank block has none)", "command line")
     ns = args.n or list(bench.DEFAULT_NS)
     for n in ns:
         if n < 1:
@@ -53,6 +67,13 @@ def _bench(args, argv: Sequence[str]) -> int:
 
     results = bench.run(ns, args.steps, on_result=progress, compare=args.compare,
                         stages=not args.no_stages)
+    _finish(args, argv, results)
+    return 0
+
+
+def _finish(args, argv: Sequence[str], results) -> None:
+    from .. import bench
+
     if args.json:
         print(json.dumps(results[0] if len(results) == 1 else results, indent=2))
     else:
@@ -61,6 +82,32 @@ def _bench(args, argv: Sequence[str]) -> int:
         path = os.path.join(repo_root(), "BENCHMARKS.md")
         bench.record(results, " ".join([PROG] + [shlex.quote(a) for a in argv]), path)
         print(f"{PROG}: appended to {path}", file=sys.stderr)
+
+
+def _bench_presets(args, argv: Sequence[str]) -> int:
+    """--preset: each preset to its end time (every one checked before the first runs)."""
+    from .. import bench, config
+
+    if args.n or args.compare:
+        raise ParameterError("--n/--compare", "given", "not with --preset (a preset sets its "
+                             "own particles and numerics; use --set)", "command line")
+    if args.max_steps is not None and args.max_steps < 1:
+        raise ParameterError("max-steps", args.max_steps, "an integer >= 1", "command line")
+    quality = args.quality or "booth"
+    resolved = [config.load(spec, quality, args.sets) for spec in args.preset]
+    start_backend(args)
+    results = []
+    for r in resolved:
+        progress = Progress(r.t_end, args.json, args.max_steps,
+                            first_label=f"{r.name} {quality}: first step")
+        res = bench.run_preset(r, stages=not args.no_stages, max_steps=args.max_steps,
+                               progress=progress)
+        results.append(res)
+        if not args.json:
+            print(f"  {res['label']}: {res['run_s']:.1f} s to t = "
+                  f"{1e3 * res['simulated_s']:.3g} ms ({res['steps']} steps)",
+                  file=sys.stderr, flush=True)
+    _finish(args, argv, results)
     return 0
 
 
@@ -68,7 +115,8 @@ def register(sub, common) -> None:
     p = sub.add_parser("bench", parents=common, formatter_class=Fmt, epilog=BENCH_EPILOG,
                        help="particle-steps per second of the full step on a 3D block",
                        description="Time the full explicit MPS step on a 3D block of water "
-                                   "resting in a tank.")
+                                   "resting in a tank, or (--preset) presets run to their "
+                                   "end time.")
     p.add_argument("--n", type=int, nargs="+", metavar="N",
                    help="fluid particles, one run each (default: 100000 300000)")
     p.add_argument("--steps", type=int, default=20, metavar="S", help="timed steps per run (default: 20)")
@@ -78,6 +126,14 @@ def register(sub, common) -> None:
                    help="run the seed's formulation and the tuned one for each N; print the ratio")
     p.add_argument("--no-stages", action="store_true",
                    help="skip the stage-by-stage timing (5 extra steps per run)")
+    p.add_argument("--preset", nargs="+", metavar="PRESET",
+                   help="run these presets to their end time instead of the tank block")
+    p.add_argument("--quality", choices=QUALITIES,
+                   help="quality rung of --preset (default: booth)")
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a value of --preset (as in crowndemo run)")
+    p.add_argument("--max-steps", type=int, metavar="N",
+                   help="stop each --preset run after N steps (a smoke test)")
     p.add_argument("--record", action="store_true",
                    help="append a section (machine, arch, date, command, table) to BENCHMARKS.md "
                         "at the repository root")

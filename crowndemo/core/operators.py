@@ -50,7 +50,8 @@ class Operators:
     @ti.kernel
     def number_density(self, out: ti.template()):
         """out_i = sum_j w(|r_ij|) (S9), all kinds counted."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] != GONE:
                 acc = 0.0
                 self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
@@ -60,7 +61,8 @@ class Operators:
     @ti.kernel
     def gradient(self, phi: ti.template(), out: ti.template()):
         """out_i = d/n0 sum_j (phi_j - phi_i)/r^2 r_ij w (S11), for fluid particles."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 acc = ti.Vector.zero(float, self.dim)
                 self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
@@ -90,7 +92,8 @@ class Operators:
     @ti.kernel
     def laplacian(self, phi: ti.template(), out: ti.template()):
         """out_i = 2d/(lambda0 n0) sum_j (phi_j - phi_i) w (S12), for fluid particles."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 acc = phi[i] * 0.0
                 self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],

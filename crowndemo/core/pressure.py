@@ -71,7 +71,8 @@ class Pressure:
         neighbour list, each fluid particle's non-dummy neighbours are listed on the way."""
         n0, c2, rho, beta = self.coef.n0[None], self.coef.c2[None], self.coef.rho[None], \
             self.coef.beta[None]
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             k = self.state.kind[i]
             if k == FLUID or k == WALL:
                 n = 0.0
@@ -118,7 +119,8 @@ class Pressure:
         P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum).
         The neighbours come from the list of ``density_and_pressure`` (same positions) where
         it holds them all, else from the cell walk."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 p_i = self.state.pressure[i]
                 xi = self.state.pos[i]
@@ -154,7 +156,8 @@ class Pressure:
                     p_ref = -p_i
                 grad = self.dim / self.coef.n0[None] * (acc.pg - p_ref * acc.g)
                 self.state.scratch_vec[i] = -grad / self.coef.rho[None]
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 self.state.vel[i] += dt * self.state.scratch_vec[i]
                 self.state.pos[i] += dt * dt * self.state.scratch_vec[i]

@@ -8,6 +8,19 @@ import taichi as ti
 FLUID, WALL, DUMMY, GONE = 0, 1, 2, 3
 KIND_NAMES = {FLUID: "fluid", WALL: "wall", DUMMY: "dummy", GONE: "gone"}
 
+# Taichi's CPU backend cuts a parallel ``for k in range(n)`` into one contiguous piece per
+# thread (its pass make_cpu_multithreaded_range_for), not into blocks taken on demand. Particles
+# in cell order put the floor's wall and dummy layers in the first half and the fluid in the
+# second, so one thread did nearly all of a fluid pass (1.16 cores busy of 2, BENCHMARKS.md).
+# ``spread`` deals chunks of SPREAD_CHUNK particles to the threads in turn instead.
+SPREAD_CHUNK = 256
+
+
+def _cpu_threads() -> int:
+    """Threads a CPU range-for is cut into; 1 on a GPU arch (blocks are scheduled there)."""
+    cfg = ti.lang.impl.current_cfg()
+    return max(int(cfg.cpu_max_num_threads), 1) if cfg.arch in (ti.x64, ti.arm64) else 1
+
 
 def field_nbytes(f) -> int:
     """Bytes held by a Taichi field."""
@@ -27,6 +40,8 @@ class ParticleState:
     def __init__(self, dim: int, capacity: int):
         self.dim, self.capacity = dim, int(capacity)
         self.n = ti.field(ti.i32, shape=())           # active particles
+        self.threads = _cpu_threads()
+        self.chunks_per_thread = ti.field(ti.i32, shape=())    # see spread
         self._persistent: Dict[str, ti.Field] = {}
         self.pos = self._register("pos", ti.Vector.field(dim, float, self.capacity))
         self.vel = self._register("vel", ti.Vector.field(dim, float, self.capacity))
@@ -72,7 +87,25 @@ class ParticleState:
         self.pressure.from_numpy(zero_f)
         self.density.from_numpy(zero_f)
         self.exit_reason.from_numpy(np.zeros(self.capacity, dtype=np.int32))
+        self._set_count(n)
+
+    def _set_count(self, n: int) -> None:
         self.n[None] = n
+        self.chunks_per_thread[None] = n // (SPREAD_CHUNK * self.threads)
+
+    @ti.func
+    def spread(self, k):
+        """The particle that index k of a parallel ``for k in range(n)`` handles: a one-to-one
+        map of [0, n) that gives thread t the chunks t, t + T, t + 2T, ... (T threads) of the
+        whole range, so every thread gets its share of each region. Per-particle results do
+        not depend on it; it only balances the threads (identity on one thread or a GPU)."""
+        i = k
+        if ti.static(self.threads > 1):
+            m = self.chunks_per_thread[None]
+            q = k // SPREAD_CHUNK
+            if q < m * self.threads:      # the tail past the last full round keeps its place
+                i = ((q % m) * self.threads + q // m) * SPREAD_CHUNK + k % SPREAD_CHUNK
+        return i
 
     def snapshot(self) -> Dict[str, np.ndarray]:
         """Every persistent field as numpy, in particle-id order (independent of any re-sort)."""
@@ -106,7 +139,7 @@ class ParticleState:
             if name == "kind":
                 full[n:] = GONE
             f.from_numpy(full)
-        self.n[None] = n
+        self._set_count(n)
 
     # ---- the one permutation of every persistent field -----------------------------------
     def permute(self, order: ti.Field) -> None:

@@ -26,6 +26,9 @@ from .params import Model
 from .plane_floor import FLOOR_V, PlaneFloor
 from .state import DUMMY, FLUID
 
+CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per particle (rare: the
+#                     lattice has none; a splash a few)
+
 
 @ti.func
 def surface_tension_pair(rij, r, l0, re):
@@ -43,7 +46,24 @@ class Predictor:
         self.floor = floor          # the analytic plane floor when the model has one
         self.dim = model.dim
         self.pair_sums = ti.types.struct(visc=ti.types.vector(self.dim, float),
-                                         st=ti.types.vector(self.dim, float))
+                                         st=ti.types.vector(self.dim, float), close=ti.i32)
+        # the pairs closer than the collision distance, listed by the viscosity and surface
+        # tension walk at the same positions, so the collision pass needs no walk of its own
+        # (a particle with more than CLOSE_SLOTS walks the cells; not allocated without it)
+        self.close_count = self.close_index = None
+        if self.lists_close_pairs:
+            self.close_count = ti.field(ti.i32, self.state.capacity)
+            self.close_index = ti.field(ti.i32, (self.state.capacity, CLOSE_SLOTS))
+
+    @property
+    def lists_close_pairs(self) -> bool:
+        return self.model.collision and self._pair_terms
+
+    def nbytes(self) -> int:
+        from .state import field_nbytes
+        if not self.lists_close_pairs:
+            return 0
+        return field_nbytes(self.close_count) + field_nbytes(self.close_index)
 
     @property
     def needs_neighbours(self) -> bool:
@@ -73,6 +93,11 @@ class Predictor:
     def _pair(self, i, j, rij, r2, acc: ti.template()):
         """Sums, without their constant factors: sum (u_j - u_i) w (S12; walls have u = 0,
         no-slip) and sum (r - l0)(r - re) r_ij / r over fluid j (S24)."""
+        if ti.static(self.lists_close_pairs):
+            if r2 < self.coef.col_r2[None]:      # every kind, as the collision walk
+                if acc.close < CLOSE_SLOTS:
+                    self.close_index[i, acc.close] = j
+                acc.close += 1
         kind_j = self.state.kind[j]
         if kind_j != DUMMY:
             r = ti.sqrt(r2)
@@ -101,12 +126,15 @@ class Predictor:
         if ti.static(self._pair_terms):
             visc = self.coef.nu[None] * (2.0 * self.dim) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
-            for i in range(self.state.n[None]):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:
                     acc = self.pair_sums(visc=ti.Vector.zero(float, self.dim),
-                                         st=ti.Vector.zero(float, self.dim))
+                                         st=ti.Vector.zero(float, self.dim), close=0)
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._pair, acc)
+                    if ti.static(self.lists_close_pairs):
+                        self.close_count[i] = acc.close
                     if ti.static(self.model.plane_floor and self.model.viscosity):
                         # the floor's wall layer, u_j = 0 (S12 summed in plane_floor.py)
                         acc.visc -= self.state.vel[i] * self.floor.at(
@@ -119,11 +147,13 @@ class Predictor:
                     if ti.static(self.model.gravity):
                         a += self.coef.gravity[None]
                     self.state.scratch_vec[i] = self.state.vel[i] + dt * a
-            for i in range(self.state.n[None]):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:
                     self.state.vel[i] = self.state.scratch_vec[i]
         elif ti.static(self.model.gravity):
-            for i in range(self.state.n[None]):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:
                     self.state.vel[i] += dt * self.coef.gravity[None]
 
@@ -131,11 +161,22 @@ class Predictor:
     def collide(self):
         """The collision model on u* at r^k; Jacobi: every pair sees the u* of both before
         either changes."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 du = ti.Vector.zero(float, self.dim)
-                self.grid.for_each_near(i, self.state.pos[i], self.coef.col_r2[None],
-                                        self._collision_pair, du)
+                xi = self.state.pos[i]
+                walk = True
+                if ti.static(self.lists_close_pairs):
+                    if self.close_count[i] <= CLOSE_SLOTS:   # the list holds them all
+                        walk = False
+                        for m in range(self.close_count[i]):
+                            j = self.close_index[i, m]
+                            rij = self.state.pos[j] - xi
+                            self._collision_pair(i, j, rij, rij.dot(rij), du)
+                if walk:
+                    self.grid.for_each_near(i, xi, self.coef.col_r2[None],
+                                            self._collision_pair, du)
                 if ti.static(self.model.plane_floor):
                     # against the floor's wall layer (the plane s = -l0/2), as against a wall
                     # particle right below: the whole approach speed changes
@@ -144,13 +185,15 @@ class Predictor:
                     if gap < ti.sqrt(self.coef.col_r2[None]) and vn < 0.0:
                         du[self.dim - 1] -= (1.0 + self.coef.col_e[None]) * vn
                 self.state.scratch_vec[i] = self.state.vel[i] + du
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 self.state.vel[i] = self.state.scratch_vec[i]
 
     @ti.kernel
     def move(self, dt: float):
         """r* = r + dt u* (S16)."""
-        for i in range(self.state.n[None]):
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 self.state.pos[i] += dt * self.state.vel[i]
