@@ -201,6 +201,7 @@ def run_preset(resolved, stages: bool = True, max_steps: Optional[int] = None,
                       "dummy": counts.get("dummy", 0), "gone": counts.get("gone", 0)},
         "steps": int(stats.steps),
         "binding_limits": dict(stats.binding),
+        "health": stats.as_dict()["health"],     # to compare variants of one preset
         "run_s": run_s,
         "seconds": seconds,
         "seconds_per_step": per_step,

@@ -130,3 +130,31 @@ def test_a_trimmed_films_raised_edge_is_not_the_crown():
     m = measure(pts, 1e-3, H, D, L0, edge=film_edge(extent, L0))
     assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
     assert m.rim_height == pytest.approx(top - H, abs=L0) and m.crown
+
+
+def test_the_rule_looks_inside_the_film_edge_or_the_container_walls():
+    """verdicts.film_limit: a trimmed film stops at its free edge; an untrimmed one at the
+    container's side walls (the largest disc on the square floor, 10 % inside), so liquid
+    raised along the walls or in a corner is not the crown (the 3m-drop booth run at 4 ms)."""
+    from crowndemo.validate.crown_metrics import film_edge
+    from crowndemo.validate.verdicts import film_limit
+    l0 = 3.0e-4
+    assert film_limit({"trimmed": True, "extent_m": 0.03, "floor_m": 0.09}, l0) == \
+        pytest.approx(0.027)
+    assert film_limit({"trimmed": False, "extent_m": 0.045, "floor_m": 0.09}, l0) == \
+        pytest.approx(0.045 - 0.0045)
+    assert film_limit(None, l0) is None and film_limit({}, l0) is None
+    # a square film 16 mm wide (walls at 8 mm) with a crown wall at 3 mm and liquid raised
+    # 5 l0 in its corners: measured inside the walls, the crown is the wall at 3 mm
+    R, T, top, half = 3.0e-3, 4 * L0, H + 2.0e-3, 8.0e-3
+    square = film(half * math.sqrt(2))
+    square = square[np.all(np.abs(square[:, :2]) < half, axis=1)]
+    corner = square[np.hypot(square[:, 0], square[:, 1]) > 1.2 * half]
+    corner = corner + np.array([0.0, 0.0, 5 * L0])
+    pts = np.concatenate([square, shell(R, T, lambda t: top), corner])
+    fooled = measure(pts, 1e-3, H, D, L0)         # the corners taken for the crown's foot
+    assert fooled.base_radius > 0.8 * half and not fooled.crown
+    m = measure(pts, 1e-3, H, D, L0, edge=film_limit({"floor_m": 2 * half}, L0))
+    assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
+    assert m.rim_height == pytest.approx(top - H, abs=L0) and m.crown
+    assert film_edge(half, L0) == pytest.approx(0.9 * half)

@@ -6,10 +6,10 @@ import pytest
 
 from crowndemo.core import (FLUID, InstabilityError, Numerics, ParameterError, simulator_for)
 from crowndemo.scenes import circularity, dam_break, hydrostatic_tank, square_patch
-from crowndemo.validate.cases import fluid_pressure_profile
+from crowndemo.validate.cases import dam_break_fronts, fluid_pressure_profile
 from crowndemo.scenes.drop import resting_drop
 from crowndemo.validate.observables import (fit_time_origin, lattice_cohesion_pressure,
-                                            mechanical_pressure, surge_front)
+                                            mechanical_pressure)
 
 RHO, G = 998.0, 9.81
 
@@ -37,18 +37,7 @@ def test_dam_break_surge_front_2d():
     a, l0 = 0.05, 2.0e-3
     scene = dam_break(dim=2, a=a, l0=l0)
     sim = simulator_for(scene)
-    scale = math.sqrt(2 * G / a)
-    T = np.arange(0.0, MARTIN_MOYCE[-1][0] + 1e-9, 0.05)
-    front = []
-
-    def record(s, i):
-        # the front of the continuous liquid (the connected body); particles thrown ahead of
-        # it are spray, not the surge front Martin & Moyce photographed
-        snap = s.snapshot()
-        front.append(surge_front(snap["pos"][snap["kind"] == FLUID], l0) / a)
-
-    sim.run(T[-1] / scale, frame_times=list(T / scale), on_frame=record)
-    z = np.array(front)
+    T, z = dam_break_fronts(sim, a, MARTIN_MOYCE[-1][0])      # the validate case's sampling
     T_ref = np.array([t for t, _ in MARTIN_MOYCE])
     Z_ref = np.array([Z for _, Z in MARTIN_MOYCE])
     assert z[0] == pytest.approx(1.0, abs=0.5 * l0 / a)        # the column's side at T = 0

@@ -8,8 +8,11 @@ Two figures measured on crown runs (2026-11-22, AMD EPYC, 2 cores, f32) correct 
   the particle collision model (2m-drop draft: 15.7 m/s at c = 31.3 m/s; 3m-drop draft:
   20.1 m/s at c = 40 m/s; 0.85 c before the model, when collapsing surface pairs were kicked
   apart), so from contact on the Courant limit binds at v ~ 0.5 c, not at the drop's speed U;
-- a crown step costs about twice a bench step per particle (2m-drop draft: 3.3 steps/s x
-  251,607 particles = 8.3e5 particle-steps/s; quick: 9.3e5; the bench: 1.6e6).
+- a crown step costs about 0.8 of a bench step per particle, counting every particle (the
+  booth 3m-drop, `crowndemo bench --preset 3m-drop`: 643,033 particles x 1,442 steps in 286 s
+  = 3.2e6 particle-steps/s, against the bench's 2.6e6 at 300k; the floor's dummy particles
+  cost little). It was twice until the threads were balanced and the cell limit raised
+  (BENCHMARKS.md, 17:17 and 17:23 sections).
 
 ``steps_to_end`` gives both the floor (dt at v = U all along) and the expected count.
 """
@@ -31,7 +34,7 @@ FALLBACK_RATE = 8.0e5        # fluid particle-steps/s, 3D, f32
 FALLBACK_COMPILE_S = 5.0
 FALLBACK_BYTES = 92.0        # per particle (fields + cell grid), f32
 SPLASH_MACH = 0.5            # fastest particle / c after contact (measured, see above)
-CROWN_COST = 2.0             # a crown step's cost per particle / the bench's (measured)
+CROWN_COST = 0.8             # a crown step's cost per particle / the bench's (measured)
 
 
 @dataclass(frozen=True)

@@ -90,25 +90,35 @@ def _hydrostatic(dim: int) -> Case:
 
 
 # ---- dam break -----------------------------------------------------------------------------
+def dam_break_fronts(sim, a: float, T_last: float, every: float = 0.05
+                     ) -> Tuple[np.ndarray, np.ndarray]:
+    """Run a dam break of column width ``a`` to T_last (T = t sqrt(2 g / a)) and sample the
+    surge front Z = z/a every ``every`` in T, dense enough to fit a time origin: the leading
+    edge of the connected liquid (particles thrown ahead of it are spray, not the front
+    Martin & Moyce photographed). Returns (T, Z)."""
+    scale = math.sqrt(2 * G / a)
+    grid = np.arange(0.0, T_last + 1e-9, every)
+    front: List[float] = []
+
+    def sample(s, i):
+        snap = s.snapshot()
+        front.append(surge_front(snap["pos"][snap["kind"] == FLUID], s.physics.l0) / a)
+
+    sim.run(grid[-1] / scale, frame_times=list(grid / scale), on_frame=sample)
+    return grid, np.array(front)
+
+
 def _dam_break(dim: int) -> Case:
     a = 0.05 if dim == 2 else 0.03
     points = [(T, Z) for T, Z in MARTIN_MOYCE if T <= 3.0]
 
-    def _front(sim) -> float:     # the leading edge of the connected liquid body
-        snap = sim.snapshot()
-        return surge_front(snap["pos"][snap["kind"] == FLUID], sim.physics.l0)
-
     def run(l0: float, numerics: Numerics) -> Outcome:
         scene = dam_break(dim=dim, a=a, l0=l0, numerics=numerics)
         sim = simulator_for(scene)
-        scale = math.sqrt(2 * G / a)
-        grid = np.arange(0.0, points[-1][0] + 1e-9, 0.05)     # T, dense for the shift
-        front: List[float] = []
-        sim.run(grid[-1] / scale, frame_times=list(grid / scale),
-                on_frame=lambda s, i: front.append(_front(s) / a))
+        grid, front = dam_break_fronts(sim, a, points[-1][0])
         T_ref = np.array([T for T, _ in points])
         Z_ref = np.array([Z for _, Z in points])
-        fit = fit_time_origin(grid, np.array(front), T_ref, Z_ref)
+        fit = fit_time_origin(grid, front, T_ref, Z_ref)
         ratios = fit["ratios"]
         worst = int(np.argmax(np.abs(ratios - 1)))
         extra = {f"Z/Z_ref at T={T:g}": float(r) for T, r in zip(T_ref, ratios)}

@@ -7,9 +7,10 @@ y = 0), the floor surface z = 0, the undisturbed film surface z = h. In 2D the '
 
 The rules, each a few lines below:
 - raised liquid: particles more than 2 l0 above the undisturbed film surface, and nearer the
-  axis than ``edge`` when one is given (a trimmed film's free edge, which slumps and rises on
-  its own: by 4 ms it stood 2 l0 above the film at r = 55 mm in the 3m-drop booth run, and
-  the rule took it for the crown's foot);
+  axis than ``edge`` when one is given (inside a trimmed film's free edge, which slumps and
+  rises on its own, or inside the container's side walls: by 4 ms the liquid in a corner of
+  the 3m-drop booth run stood 2 l0 above the film at r = 55 mm, and the rule took it for the
+  crown's foot; ``verdicts.film_limit``);
 - the main body is the largest group of particles linked at 1.5 l0; every other group above
   the film is an ejected droplet;
 - base radius: per azimuthal sector, the outermost raised particle of the main body in the
@@ -44,7 +45,8 @@ CROWN_MIN_BASE_D = 0.5
 
 
 def film_edge(extent: Optional[float], l0: float) -> Optional[float]:
-    """Where a trimmed film's free-edge effects begin: 10 % of its radius or 5 l0 inside it."""
+    """Where the effects of a film's edge (a trimmed film's free edge, or the container's
+    walls at ``extent`` from the axis) begin: 10 % of ``extent`` or 5 l0 inside it."""
     if extent is None:
         return None
     return extent - max(0.1 * extent, 5.0 * l0)
