@@ -99,7 +99,7 @@ def _bench_presets(args, argv: Sequence[str]) -> int:
     results = []
     for r in resolved:
         progress = Progress(r.t_end, args.json, args.max_steps,
-                            first_label=f"{r.name} {quality}: first step")
+                            first_label=f"{r.name} {quality}: set-up and first step")
         res = bench.run_preset(r, stages=not args.no_stages, max_steps=args.max_steps,
                                progress=progress)
         results.append(res)
