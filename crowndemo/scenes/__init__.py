@@ -1,5 +1,6 @@
 """Scene builders: particles, parameters and domain for each kind of run."""
-from .base import Scene, container_walls, lattice_block, wall_layers
+from ..core.lattice import wall_layers
+from .base import Scene, container_walls, lattice_block
 from .crown import crown, crown_base_radius
 from .reference import circularity, dam_break, equivalent_radius, hydrostatic_tank, square_patch
 

@@ -7,7 +7,6 @@ from typing import Iterable, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..core.lattice import wall_layers  # noqa: F401  (re-exported for the scene builders)
 from ..core.params import Numerics, Physics
 from ..core.state import DUMMY, FLUID, WALL
 

@@ -14,8 +14,8 @@ from typing import Optional
 import numpy as np
 
 from ..core.params import Numerics, Physics
-from .base import (Scene, assemble, container_walls, floor_face, lattice_block, particle_faces,
-                   wall_layers)
+from ..core.lattice import wall_layers
+from .base import Scene, assemble, container_walls, floor_face, lattice_block, particle_faces
 
 
 def crown_base_radius(t: float, U: float, D: float, h: float) -> float:

@@ -8,7 +8,8 @@ from typing import Optional
 import numpy as np
 
 from ..core.params import Numerics, Physics
-from .base import Scene, assemble, container_walls, lattice_block, particle_faces, wall_layers
+from ..core.lattice import wall_layers
+from .base import Scene, assemble, container_walls, lattice_block, particle_faces
 
 WATER = dict(rho=998.0, nu=1.0e-6, sigma=0.0728)
 
