@@ -102,6 +102,18 @@ def test_bench_preset_json(capsys):
     assert data["particles"]["total"] > data["particles"]["fluid"] > 10_000
 
 
+def test_bench_preset_unstable_reports_the_finished_ones(tmp_path, capsys):
+    # the drop falls at U = c/5 from the start: with max_mach = 0.1 a run stops at step 1.
+    # quick-2d finishes its 2 steps first; its row is printed, then the one-line error.
+    bad = tmp_path / "unstable.yaml"
+    bad.write_text("extends: quick\nnumerics: {max_mach: 0.1}\n")
+    assert main(["bench", "--preset", "quick-2d", str(bad), "--quality", "draft",
+                 "--max-steps", "2", "--no-stages"]) == 3
+    out, err = capsys.readouterr()
+    assert "quick-2d draft" in out and "unstable draft" not in out
+    assert "unstable at step 1" in err and "Traceback" not in err
+
+
 def test_scene_dam_break_2d(capsys):
     assert main(["scene", "dam-break", "--dim", "2", "--t-end", "0.005"]) == 0
     out = capsys.readouterr().out

@@ -7,6 +7,7 @@ import shlex
 import sys
 from typing import Sequence
 
+from ..core.health import InstabilityError
 from ..core.params import ParameterError
 from ..config.schema import QUALITIES
 from .common import PROG, Fmt, Progress, repo_root, start_backend
@@ -40,6 +41,8 @@ neighbour list, re-sort every step). It prints tuned / seed.
 set-up, the first step, which compiles or loads the kernels, and every step), "start-up s" its
 set-up and first step; particle-steps/s counts fluid particles over the steps after the first,
 which are also timed stage by stage (the stage timer waits for the device after each stage).
+A preset that goes unstable ends the command (exit status 3, the step and the limit it broke)
+after the presets before it are reported (and recorded, with --record).
 """
 
 
@@ -100,8 +103,13 @@ def _bench_presets(args, argv: Sequence[str]) -> int:
     for r in resolved:
         progress = Progress(r.t_end, args.json, args.max_steps,
                             first_label=f"{r.name} {quality}: set-up and first step")
-        res = bench.run_preset(r, stages=not args.no_stages, max_steps=args.max_steps,
-                               progress=progress)
+        try:
+            res = bench.run_preset(r, stages=not args.no_stages, max_steps=args.max_steps,
+                                   progress=progress)
+        except InstabilityError:
+            if results:             # the presets that finished are reported, then the error
+                _finish(args, argv, results)
+            raise
         results.append(res)
         if not args.json:
             print(f"  {res['label']}: {res['run_s']:.1f} s to t = "
