@@ -1,7 +1,9 @@
 """The one place that calls ``ti.init``: arch, float precision, random seed, threads."""
 from __future__ import annotations
 
+import atexit
 import os
+import sys
 from dataclasses import dataclass
 from typing import Optional
 
@@ -25,6 +27,21 @@ _current: Optional[Backend] = None
 
 class BackendError(ValueError):
     """A bad arch/precision choice, reported before any kernel runs."""
+
+
+def _finish() -> None:
+    """At exit: close any GGUI window, then finish Taichi, which writes the kernels compiled
+    in this process to Taichi's offline cache. Interpreter shutdown alone does not always
+    finish it (it depends on the order in which objects are collected): runs then compiled
+    every kernel afresh each time (BENCHMARKS.md, "offline cache written at exit")."""
+    global _current
+    if _current is None:
+        return
+    window = sys.modules.get("crowndemo.render.window")
+    if window is not None:
+        window._close_all()
+    ti.reset()
+    _current = None
 
 
 def _arch_object(name: str):
@@ -52,6 +69,8 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
         return _current
     if _current is not None:
         ti.reset()
+    else:
+        atexit.register(_finish)    # once: _current is None only before the first init
     kwargs = dict(default_fp=ti.f64 if precision == "f64" else ti.f32,
                   default_ip=ti.i32, random_seed=int(seed), offline_cache=True,
                   log_level=ti.WARN if quiet else ti.INFO)
