@@ -59,6 +59,7 @@ def test_listed_close_pairs_collide_as_the_model(dim):
     sim.load(pos, vel, kind)
     # the predictor's two passes, by hand: u* (viscosity and surface tension), then collisions
     sim.grid.build(sim.lattice.re, reorder=False)
+    sim.predictor.forces()
     sim.predictor.accelerate(1.0e-5)
     u_star = sim.state.vel.to_numpy()[: len(pos)].astype(float)
     counts = sim.predictor.close_count.to_numpy()[: len(pos)]

@@ -104,6 +104,21 @@ def test_info_preset_text_and_json(capsys):
     assert d["memory_bytes"] > 0 and d["steps_at_U"] == math.ceil(4e-3 / d["dt_s"] - 1e-9) + 16
     assert d["steps"] > d["steps_at_U"] and d["run_seconds_estimate"] > d["run_seconds_at_U"]
     assert d["left_out"] == [] or all(isinstance(s, str) for s in d["left_out"])
+    # the crown presets take the Courant limit on relative speeds (README, "The time step"):
+    # after contact at 0.3 c relative (the approach limit at the splash's 0.5 c), against
+    # 0.5 c for the seed's absolute form, so fewer steps
+    assert d["numerics"]["courant_speed"] == "relative"
+    assert d["limits_s"]["approach"] == pytest.approx(0.5 * 3e-4 / 8.0)
+    c = d["sound_speed_m_s"]
+    assert d["relative_speed_m_s"] == pytest.approx(0.3 * c)
+    assert d["dt_after_contact_s"] == pytest.approx(
+        min(0.2 * 3e-4 / (0.3 * c), 0.5 * 3e-4 / (0.5 * c), 3e-4 / c))
+    assert main(["info", "3m-drop", "--quality", "booth", "--json",
+                 "--set", "numerics.courant_speed=absolute"]) == 0
+    a = json.loads(capsys.readouterr().out)
+    assert "approach" not in a["limits_s"] and a["relative_speed_m_s"] is None
+    assert a["dt_after_contact_s"] == pytest.approx(0.2 * 3e-4 / (0.5 * c))
+    assert a["steps"] > d["steps"]
 
 
 def test_info_lattice_form_still_works_and_forms_do_not_mix(capsys):

@@ -131,6 +131,7 @@ def test_predictor_pair_acceleration(pair_sim, ratio):
     rij = load_pair(pair_sim, r, (1.0, 2.0, -0.5))
     dt = 1.0e-5
     pair_sim.grid.build(RE_RATIO * L0)
+    pair_sim.predictor.forces()
     pair_sim.predictor.run(dt)
     a = pair_sim.state.vel.to_numpy()[:2] / dt
     a_ref = expected_acceleration(dim, rij)

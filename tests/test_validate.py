@@ -89,7 +89,8 @@ def test_dam_break_case_reports_worst_point():
 # ---- quick stability subset ---------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def stability_rows():
-    names = ["fixed-dt-3x", "touching", "dry-floor", "thrown-out"]
+    names = ["fixed-dt-3x", "touching", "dry-floor", "thrown-out", "impact-15m-s-relative",
+             "dry-floor-relative"]
     return {r.case: r for r in stability.run_suite(names)}
 
 
@@ -98,7 +99,8 @@ def test_fixed_dt_over_a_limit_is_refused_naming_it(stability_rows):
     assert r.outcome.startswith("refused") and "acoustic" in r.outcome and r.steps == 0
 
 
-@pytest.mark.parametrize("name", ["touching", "dry-floor"])
+@pytest.mark.parametrize("name", ["touching", "dry-floor", "impact-15m-s-relative",
+                                  "dry-floor-relative"])
 def test_extreme_impacts_run_to_the_end_healthy(stability_rows, name):
     r = stability_rows[name]
     assert r.outcome == "ran to the end", r.outcome

@@ -152,13 +152,14 @@ def _preset_facts(r, tp) -> Dict:
         "sound_speed_m_s": ph.c,
         "sound_speed_source": "given" if s.get("sound_speed") is not None else "5 x speed",
         "numerics": numerics, "model": Model.describe(r.model),
-        "limits_s": {key: lim.get(key) for key in ("courant", "acoustic", "viscous",
-                                                    "capillary", "dt_max")
-                     if key != "dt_max" or key in lim},
+        "limits_s": {key: lim.get(key) for key in ("courant", "approach", "acoustic",
+                                                    "viscous", "capillary", "dt_max")
+                     if key not in ("dt_max", "approach") or key in lim},
         "dt_s": dt, "binding": est["binding"], "binding_ties": ties,
         "particles": est["particles"], "memory_bytes": est["memory_bytes"],
         "steps": est["steps"], "steps_at_U": est["steps_at_U"],
         "splash_speed_m_s": est["splash_speed_m_s"],
+        "relative_speed_m_s": est["relative_speed_m_s"],
         "dt_after_contact_s": est["dt_after_contact_s"],
         "binding_after_contact": est["binding_after_contact"],
         "run_seconds_estimate": est["run_seconds"],
@@ -227,7 +228,9 @@ def _info_preset(args) -> int:
     print(f"  sound speed c = {f['sound_speed_m_s']:.4g} m/s ({f['sound_speed_source']})")
     n = f["numerics"]
     beta = n["beta"] if n["beta"] is not None else r.numerics.free_surface_beta(r.dim)
-    print(f"  numerics    gradient {n['pressure_gradient']}; safety courant {n['courant']:g}, "
+    relative = n["courant_speed"] == "relative"
+    print(f"  numerics    gradient {n['pressure_gradient']}; safety courant {n['courant']:g}"
+          + (f" on relative speeds, approach {n['approach']:g}" if relative else "") + ", "
           f"acoustic {n['acoustic']:g}, viscous {n['viscous']:g}, capillary {n['capillary']:g}; "
           f"beta {beta:g}")
     print("              collision model: " + (
@@ -237,7 +240,8 @@ def _info_preset(args) -> int:
           f"{n['max_mach']:g}, {n['max_out_fraction']:g} of the fluid out; dt_max "
           f"{n['dt_max'] if n['dt_max'] is not None else 'none'}, fixed dt "
           f"{n['fixed_dt'] if n['fixed_dt'] is not None else 'none (adaptive)'}")
-    rules = {"courant": f"{n['courant']:g} l0 / U", "acoustic": f"{n['acoustic']:g} l0 / c",
+    rules = {"courant": f"{n['courant']:g} l0 / U" + (" (relative speed)" if relative else ""),
+             "approach": f"{n['approach']:g} l0 / U", "acoustic": f"{n['acoustic']:g} l0 / c",
              "viscous": f"{n['viscous']:g} l0^2 / nu",
              "capillary": f"{n['capillary']:g} sqrt(rho l0^3 / (2 pi sigma))",
              "dt_max": "numerics.dt_max"}
@@ -256,10 +260,13 @@ def _info_preset(args) -> int:
           f"({approx}{p['total']:,} total{how})")
     print(f"  memory      ~{estimate.human_bytes(f['memory_bytes'])} ({tp.bytes_per_particle:g} "
           f"bytes per particle with the cell grid, f32)")
+    speeds = (f"the splash's ~{f['splash_speed_m_s']:.3g} m/s = {estimate.SPLASH_MACH:g} c")
+    if relative:
+        speeds = (f"a relative speed of ~{f['relative_speed_m_s']:.3g} m/s = "
+                  f"{estimate.SPLASH_RELATIVE_MACH:g} c, {speeds}")
     print(f"  steps       ~{f['steps']:,} to t_end: dt {f['dt_s']:.3g} s until contact, then "
-          f"{f['dt_after_contact_s']:.3g} s ({f['binding_after_contact']} at the splash's "
-          f"~{f['splash_speed_m_s']:.3g} m/s = {estimate.SPLASH_MACH:g} c); at least "
-          f"{f['steps_at_U']:,} (v = U all along)")
+          f"{f['dt_after_contact_s']:.3g} s ({f['binding_after_contact']} at {speeds}); at "
+          f"least {f['steps_at_U']:,} (v = U all along)")
     print(f"  run time    ~{estimate.human_seconds(f['run_seconds_estimate'])} on the CPU of "
           f"BENCHMARKS.md (at least {estimate.human_seconds(f['run_seconds_at_U'])}): "
           f"{tp.rate_total:.3g} particle-steps/s counting every particle, / "

@@ -97,8 +97,9 @@ def _presets(args) -> int:
                 f"particle x steps x {estimate.CROWN_COST:g} (a crown step's cost) / "
                 f"{tp.rate_total:.3g} particle-steps/s ({tp.rate:.3g} fluid; {tp.source}); "
                 f"steps: dt at the drop's speed until contact, then at the splash's "
-                f"{estimate.SPLASH_MACH:g} c (measured). Details: crowndemo info PRESET "
-                f"--quality Q.", 96):
+                f"{estimate.SPLASH_MACH:g} c, or with the Courant limit on relative speeds "
+                f"at {estimate.SPLASH_RELATIVE_MACH:g} c relative (measured). Details: "
+                f"crowndemo info PRESET --quality Q.", 96):
             print(line)
     for e in errors:
         error(str(e))

@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Dict, Optional, Tuple
 
-from ..core.params import GRADIENT_FORMS, WALL_MODELS
+from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, WALL_MODELS
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
 
@@ -118,6 +118,11 @@ SCENE_KEYS = {
 _C = dict(lo=0, hi=2)
 NUMERICS_KEYS = {
     "courant": number("velocity Courant number v dt / l0 (S5)", "", **_C),
+    "courant_speed": Field("choice", "v of the Courant limit: the largest particle speed "
+                           "(S5), or the largest speed relative to neighbours, walls at rest "
+                           "(core/relative_speed.py)", choices=COURANT_SPEEDS),
+    "approach": number("with courant_speed relative: the most a particle moves in a step, "
+                       "a fraction of l0", "", **_C),
     "acoustic": number("acoustic Courant number c dt / l0 (S6)", "", **_C),
     "viscous": number("viscous number nu dt / l0^2 (M1)", "", **_C),
     "capillary": number("fraction of the capillary limit (M1)", "", **_C),

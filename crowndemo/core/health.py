@@ -4,7 +4,7 @@ kinetic + gravitational energy. ``check`` turns a broken limit into an ``Instabi
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List
+from typing import Dict, List, Optional
 
 import numpy as np
 import taichi as ti
@@ -49,6 +49,7 @@ class InstabilityError(RuntimeError):
 @dataclass
 class HealthReport:
     max_speed: float = 0.0
+    max_relative_speed: Optional[float] = None   # measured with courant_speed: relative
     max_density_excess: float = 0.0
     kinetic: float = 0.0
     potential: float = 0.0

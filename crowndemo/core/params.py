@@ -11,6 +11,7 @@ from typing import Optional
 
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
+COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; relative_speed.py)
 
 
 class ParameterError(ValueError):
@@ -61,6 +62,11 @@ class Physics:
 @dataclass(frozen=True)
 class Numerics:
     courant: float = 0.2            # velocity Courant v dt / l0 (S5)
+    # v in the Courant limit: the largest particle speed (the seed's S5), or the largest speed
+    # of a particle relative to its neighbours, walls at rest (relative_speed.py), which also brings in the
+    # approach limit: every particle moves at most ``approach`` l0 a step
+    courant_speed: str = "absolute"
+    approach: float = 0.5           # |u| dt / l0 with courant_speed relative
     acoustic: float = 1.0           # acoustic Courant c dt / l0 (S6)
     viscous: float = 0.15           # nu dt / l0^2 (M1)
     capillary: float = 1.0          # fraction of sqrt(rho l0^3 / (2 pi sigma)) (M1)
@@ -94,7 +100,7 @@ class Numerics:
         def need(cond: bool, key: str, allowed: str):
             if not cond:
                 raise ParameterError(key, getattr(self, key), allowed, source)
-        for key in ("courant", "acoustic", "viscous", "capillary"):
+        for key in ("courant", "acoustic", "viscous", "capillary", "approach"):
             need(_finite(getattr(self, key)) and 0 < getattr(self, key) <= 2.0, key, "0 < x <= 2")
         need(self.dt_max > 0, "dt_max", "> 0 s")
         need(self.fixed_dt is None or (_finite(self.fixed_dt) and self.fixed_dt > 0),
@@ -110,6 +116,7 @@ class Numerics:
         need(_finite(self.restitution) and 0 <= self.restitution <= 1, "restitution", "0 .. 1")
         need(isinstance(self.neighbour_list, bool), "neighbour_list", "true or false")
         need(self.wall_model in WALL_MODELS, "wall_model", " | ".join(WALL_MODELS))
+        need(self.courant_speed in COURANT_SPEEDS, "courant_speed", " | ".join(COURANT_SPEEDS))
         need(isinstance(self.cells_per_re, int) and not isinstance(self.cells_per_re, bool)
              and 1 <= self.cells_per_re <= 3, "cells_per_re", "1, 2 or 3")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
@@ -132,18 +139,21 @@ class Model:
     neighbour_list: bool = True
     cells_per_re: int = 2
     plane_floor: bool = False
+    relative_courant: bool = False   # the relative-speed pass (core/relative_speed.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
-                   numerics.cells_per_re, numerics.wall_model == "plane")
+                   numerics.cells_per_re, numerics.wall_model == "plane",
+                   numerics.courant_speed == "relative")
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
                 "gravity": self.gravity, "pressure_gradient": self.pressure_gradient,
                 "collision": self.collision, "neighbour_list": self.neighbour_list,
-                "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor}
+                "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor,
+                "relative_courant": self.relative_courant}
 
 
 def _finite(x) -> bool:
@@ -160,4 +170,4 @@ def with_values(obj, **changes):
 
 
 __all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "WALL_MODELS",
-           "with_values"]
+           "COURANT_SPEEDS", "with_values"]

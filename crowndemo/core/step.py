@@ -21,11 +21,13 @@ from .operators import Operators
 from .params import Model, Numerics, Physics
 from .plane_floor import PlaneFloor
 from .pressure import Pressure
+from .relative_speed import RelativeSpeed
 from .state import FLUID, ParticleState
 from .terms import Predictor
 
 
-BINDINGS = timestep.LIMIT_NAMES + ("fixed", "frame")   # codes of RunStats.bound_log
+# codes of RunStats.bound_log; the order of older checkpoints' codes kept
+BINDINGS = timestep.LIMIT_NAMES[:5] + ("fixed", "frame") + timestep.LIMIT_NAMES[5:]
 # the stages of a step, as timed by Simulator.time_stages (crowndemo bench)
 STAGES = ("grid", "predictor", "collision", "density", "corrector", "health")
 
@@ -113,6 +115,12 @@ class Simulator:
         self.predictor = Predictor(self.model, self.grid, self.coef, self.floor)
         self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
         self.health = Health(self.state, self.coef)
+        # the relative Courant limit's speed: measured by the predictor's walk where it walks
+        # (viscosity or surface tension), else by a pass of its own after each step
+        self.relative_speed = None
+        if self.model.relative_courant and not self.predictor.measures_relative_speed:
+            self.relative_speed = RelativeSpeed(self.grid, self.coef, self.pressure.neighbours,
+                                                self.floor)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0
@@ -150,7 +158,7 @@ class Simulator:
         self.n_fluid = int((np.asarray(kind) == FLUID).sum())
         self.health.reset()
         self.stats = RunStats()
-        self._last = self._measure()
+        self._last = self._measure(pairs=False)   # no neighbour pairs yet (the speed bounds them)
         self.stats.energy_start = self._last.energy
 
     def save_state(self) -> dict:
@@ -188,10 +196,6 @@ class Simulator:
     def step(self, dt_cap: float = math.inf) -> float:
         """Advance one step; returns dt. Raises InstabilityError on a broken health limit."""
         t_first = _time.perf_counter() if self.stats.steps == 0 else None
-        dt, binding = timestep.choose(self.physics, self.numerics, self.model,
-                                      self._last.max_speed)
-        if dt_cap < dt:
-            dt, binding = dt_cap, "frame"
         re = self.lattice.re
         k = self.stats.steps
         reorder = self.numerics.reorder_every > 0 and k % self.numerics.reorder_every == 0
@@ -199,7 +203,15 @@ class Simulator:
         if self.predictor.needs_neighbours:
             self.grid.build(re, reorder=reorder)        # neighbours at r^k
             self._stage("grid")
-        self.predictor.run(dt, mark=self._stage)        # S14-S16
+        self.predictor.forces()                         # S14 at r^k
+        relative = self._last.max_relative_speed        # the relative Courant limit's speed
+        if self.predictor.measures_relative_speed:
+            relative = self.predictor.relative_speed()  # at r^k, u^k: the walk just read it
+        dt, binding = timestep.choose(self.physics, self.numerics, self.model,
+                                      self._last.max_speed, relative)
+        if dt_cap < dt:
+            dt, binding = dt_cap, "frame"
+        self.predictor.run(dt, mark=self._stage)        # S15-S16
         self.grid.build(re, reorder=reorder and not self.predictor.needs_neighbours)  # at r*
         self._stage("grid")
         self.pressure.density_and_pressure()            # S17 (M3)
@@ -228,8 +240,10 @@ class Simulator:
             raise
         return dt
 
-    def _measure(self) -> HealthReport:
+    def _measure(self, pairs: bool = True) -> HealthReport:
         report = self.health.measure()
+        if self.relative_speed is not None and pairs:
+            report.max_relative_speed = self.relative_speed.measure()
         self.stats.note(report)
         return report
 
@@ -273,4 +287,5 @@ class Simulator:
     def memory_bytes(self) -> int:
         return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
                 + self.predictor.nbytes() + self.pressure.nbytes()
-                + (self.floor.nbytes() if self.floor else 0))
+                + (self.floor.nbytes() if self.floor else 0)
+                + (self.relative_speed.nbytes() if self.relative_speed else 0))

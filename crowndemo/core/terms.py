@@ -24,6 +24,7 @@ from .grid import CellGrid
 from .operators import laplacian_pair, weight
 from .params import Model
 from .plane_floor import FLOOR_V, PlaneFloor
+from .relative_speed import BLOCK, fluid_max
 from .state import DUMMY, FLUID
 
 CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per particle (rare: the
@@ -46,7 +47,8 @@ class Predictor:
         self.floor = floor          # the analytic plane floor when the model has one
         self.dim = model.dim
         self.pair_sums = ti.types.struct(visc=ti.types.vector(self.dim, float),
-                                         st=ti.types.vector(self.dim, float), close=ti.i32)
+                                         st=ti.types.vector(self.dim, float), close=ti.i32,
+                                         rel2=float)
         # the pairs closer than the collision distance, listed by the viscosity and surface
         # tension walk at the same positions, so the collision pass needs no walk of its own
         # (a particle with more than CLOSE_SLOTS walks the cells; not allocated without it)
@@ -54,16 +56,33 @@ class Predictor:
         if self.lists_close_pairs:
             self.close_count = ti.field(ti.i32, self.state.capacity)
             self.close_index = ti.field(ti.i32, (self.state.capacity, CLOSE_SLOTS))
+        self.block_rel2 = self.rel2 = None       # only with the relative Courant limit
+        if self.measures_relative_speed:
+            self.block_rel2 = ti.field(float, (self.state.capacity + BLOCK - 1) // BLOCK)
+            self.rel2 = ti.field(float, shape=())
 
     @property
     def lists_close_pairs(self) -> bool:
         return self.model.collision and self._pair_terms
 
+    @property
+    def measures_relative_speed(self) -> bool:
+        """The speed of the relative Courant limit (relative_speed.py) measured by this walk,
+        which reads every u_j - u_i at r^k anyway, before dt is chosen."""
+        return self.model.relative_courant and self._pair_terms
+
+    def relative_speed(self) -> float:
+        """max |u_j - u_i| over the pairs of the last ``forces`` (m/s; walls at rest)."""
+        return float(self.rel2[None]) ** 0.5
+
     def nbytes(self) -> int:
         from .state import field_nbytes
-        if not self.lists_close_pairs:
-            return 0
-        return field_nbytes(self.close_count) + field_nbytes(self.close_index)
+        fields = []
+        if self.lists_close_pairs:
+            fields += [self.close_count, self.close_index]
+        if self.measures_relative_speed:
+            fields += [self.block_rel2, self.rel2]
+        return sum(field_nbytes(f) for f in fields)
 
     @property
     def needs_neighbours(self) -> bool:
@@ -101,18 +120,20 @@ class Predictor:
         kind_j = self.state.kind[j]
         if kind_j != DUMMY:
             r = ti.sqrt(r2)
+            du = self.state.vel[j] - self.state.vel[i]
+            if ti.static(self.measures_relative_speed):
+                acc.rel2 = ti.max(acc.rel2, du.dot(du))
             if ti.static(self.model.viscosity):
-                acc.visc += laplacian_pair(self.state.vel[j] - self.state.vel[i],
-                                           weight(r, self.coef.re[None]))
+                acc.visc += laplacian_pair(du, weight(r, self.coef.re[None]))
             if ti.static(self.model.surface_tension):
                 if kind_j == FLUID:      # fluid-fluid potential (sign per method.md §4)
                     acc.st += surface_tension_pair(rij, r, self.coef.l0[None],
                                                    self.coef.re[None])
 
     def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None) -> None:
-        """u* = u + dt a* (S15), the collision model on u* at r^k, r* = r + dt u* (S16),
-        a* from (S14). ``mark(stage)`` is called as the "predictor" and "collision" stages end
-        (the simulator's stage timer)."""
+        """u* = u + dt a* (S15), a* from ``forces`` (which must have run at these positions),
+        the collision model on u* at r^k, r* = r + dt u* (S16). ``mark(stage)`` is called as
+        the "predictor" and "collision" stages end (the simulator's stage timer)."""
         self.accelerate(dt)
         mark("predictor")
         if self.model.collision:
@@ -121,8 +142,12 @@ class Predictor:
         self.move(dt)
 
     @ti.kernel
-    def accelerate(self, dt: float):
-        """u* = u + dt (nu <lap u> + g + (C/m) sum grad potential) (S14-S15), into vel."""
+    def forces(self):
+        """a* = nu <lap u> + g + (C/m) sum grad potential (S14) at r^k, into scratch_vec (no
+        work without viscosity and surface tension: ``accelerate`` adds g alone). With the
+        relative Courant limit, the largest |u_j - u_i| of the walk's pairs (non-dummy j
+        within re; a particle within re of the plane floor's wall layer counts its own speed):
+        per particle into scratch_float, then reduced per block and over the blocks."""
         if ti.static(self._pair_terms):
             visc = self.coef.nu[None] * (2.0 * self.dim) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
@@ -130,15 +155,22 @@ class Predictor:
                 i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:
                     acc = self.pair_sums(visc=ti.Vector.zero(float, self.dim),
-                                         st=ti.Vector.zero(float, self.dim), close=0)
+                                         st=ti.Vector.zero(float, self.dim), close=0, rel2=0.0)
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._pair, acc)
                     if ti.static(self.lists_close_pairs):
                         self.close_count[i] = acc.close
-                    if ti.static(self.model.plane_floor and self.model.viscosity):
+                    if ti.static(self.model.plane_floor):
                         # the floor's wall layer, u_j = 0 (S12 summed in plane_floor.py)
-                        acc.visc -= self.state.vel[i] * self.floor.at(
-                            self.state.pos[i][self.dim - 1])[FLOOR_V]
+                        v_floor = self.floor.at(self.state.pos[i][self.dim - 1])[FLOOR_V]
+                        if ti.static(self.model.viscosity):
+                            acc.visc -= self.state.vel[i] * v_floor
+                        if ti.static(self.measures_relative_speed):
+                            if v_floor > 0.0:
+                                acc.rel2 = ti.max(acc.rel2, self.state.vel[i].dot(
+                                    self.state.vel[i]))
+                    if ti.static(self.measures_relative_speed):
+                        self.state.scratch_float[i] = acc.rel2
                     a = ti.Vector.zero(float, self.dim)
                     if ti.static(self.model.viscosity):
                         a += visc * acc.visc
@@ -146,11 +178,18 @@ class Predictor:
                         a += self.coef.st_over_m[None] * acc.st
                     if ti.static(self.model.gravity):
                         a += self.coef.gravity[None]
-                    self.state.scratch_vec[i] = self.state.vel[i] + dt * a
+                    self.state.scratch_vec[i] = a
+            if ti.static(self.measures_relative_speed):
+                fluid_max(self.state, self.state.scratch_float, self.block_rel2, self.rel2)
+
+    @ti.kernel
+    def accelerate(self, dt: float):
+        """u* = u + dt a* (S15), a* from ``forces``; g alone without pair terms."""
+        if ti.static(self._pair_terms):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:
-                    self.state.vel[i] = self.state.scratch_vec[i]
+                    self.state.vel[i] = self.state.vel[i] + dt * self.state.scratch_vec[i]
         elif ti.static(self.model.gravity):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)

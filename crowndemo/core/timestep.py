@@ -2,24 +2,35 @@
 from __future__ import annotations
 
 import math
-from typing import Dict, Tuple
+from typing import Dict, Optional, Tuple
 
 from .params import Model, Numerics, ParameterError, Physics
 
-LIMIT_NAMES = ("courant", "acoustic", "viscous", "capillary", "dt_max")
+# (new names go last: RunStats.bound_log stores their index, and checkpoints keep it)
+LIMIT_NAMES = ("courant", "acoustic", "viscous", "capillary", "dt_max", "approach")
 
 
-def limits(physics: Physics, numerics: Numerics, model: Model, speed: float) -> Dict[str, float]:
-    """Every limit on dt in force for this model at the given maximum speed.
+def limits(physics: Physics, numerics: Numerics, model: Model, speed: float,
+           relative_speed: Optional[float] = None) -> Dict[str, float]:
+    """Every limit on dt in force for this model at the given maximum speed (and, with
+    ``courant_speed: relative``, the largest relative speed of neighbours; None, not measured
+    yet: the maximum speed, as in the seed's form).
 
-    courant:   C_v l0 / v        (S5, S7)
+    courant:   C_v l0 / v        (S5, S7); v = the speed, or the relative speed
+                                 (relative_speed.py)
+    approach:  C_a l0 / v        (with the relative speed only: relative_speed.py)
     acoustic:  C_c l0 / c        (S6, S8)
     viscous:   k_nu l0^2 / nu    (M1; only when viscosity is compiled in)
     capillary: k_st sqrt(rho l0^3 / (2 pi sigma))  (M1; only with surface tension)
     """
     l0 = physics.l0
-    out = {"courant": numerics.courant * l0 / speed if speed > 0 else math.inf,
+    v = speed
+    if numerics.courant_speed == "relative" and relative_speed is not None:
+        v = relative_speed
+    out = {"courant": numerics.courant * l0 / v if v > 0 else math.inf,
            "acoustic": numerics.acoustic * l0 / physics.c}
+    if numerics.courant_speed == "relative":
+        out["approach"] = numerics.approach * l0 / speed if speed > 0 else math.inf
     if model.viscosity:
         out["viscous"] = numerics.viscous * l0 * l0 / physics.nu
     if model.surface_tension:
@@ -30,10 +41,10 @@ def limits(physics: Physics, numerics: Numerics, model: Model, speed: float) -> 
     return out
 
 
-def choose(physics: Physics, numerics: Numerics, model: Model, speed: float
-           ) -> Tuple[float, str]:
+def choose(physics: Physics, numerics: Numerics, model: Model, speed: float,
+           relative_speed: Optional[float] = None) -> Tuple[float, str]:
     """dt = the smallest limit (or the user's fixed dt), and the name of what binds."""
-    lim = limits(physics, numerics, model, speed)
+    lim = limits(physics, numerics, model, speed, relative_speed)
     name = min(lim, key=lim.get)
     if numerics.fixed_dt is not None:
         return numerics.fixed_dt, "fixed"

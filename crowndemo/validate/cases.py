@@ -203,7 +203,7 @@ def _laplace(dim: int) -> Case:
 def crown_case(preset: str = "quick", t_end: Optional[float] = None,
                refine: Tuple[float, ...] = (1.0, 0.8, 0.6),
                variants: Tuple[str, ...] = ("untrimmed", "safety/2", "gradient=sum",
-                                            "plane-floor")) -> Case:
+                                            "plane-floor", "relative-courant")) -> Case:
     """The crown base radius of a 3D crown preset against Yarin & Weiss's sqrt(t) law, over the
     frames after the crown has formed (tau = t U / D > 0.25 after contact)."""
     from .. import config
@@ -261,4 +261,6 @@ def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
         return replace(numerics, pressure_gradient=variant.split("=", 1)[1])
     if variant == "plane-floor":        # the analytic floor instead of its particle layers
         return replace(numerics, wall_model="plane")
+    if variant == "relative-courant":   # the crown presets' Courant limit (relative_speed.py)
+        return replace(numerics, courant_speed="relative")
     return numerics

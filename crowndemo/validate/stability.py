@@ -85,6 +85,13 @@ def _two_drops(t_end: float) -> Scene:
     return replace(sc, pos=pos, vel=vel, kind=kind, info=info)
 
 
+def _relative(sc: Scene) -> Scene:
+    """The same scene with the Courant limit on relative speeds (the crown presets' setting,
+    core/relative_speed.py): fewer, larger steps once the splash flies."""
+    sc.numerics = replace(sc.numerics, courant_speed="relative")
+    return sc
+
+
 def _thrown_out(t_end: float) -> Scene:
     """The domain's top cut 1 mm above the drop: the splash flies out and is counted."""
     sc = crown(t_end=t_end, **_kw(speed=15.0))
@@ -127,6 +134,15 @@ def cases(full: bool = False) -> Dict[str, StabilityCase]:
                       _two_drops),
         StabilityCase("thrown-out", "extreme", "the domain's top 1 mm above the drop: a 15 m/s "
                       "splash leaves it and is counted", _thrown_out),
+        StabilityCase("impact-15m-s-relative", "extreme", "a 15 m/s impact, the Courant "
+                      "limit on relative speeds (the crown presets' setting)",
+                      lambda t: _relative(crown(t_end=t, **_kw(speed=15.0)))),
+        StabilityCase("touching-relative", "extreme", "the drop touching the film at t = 0, "
+                      "the Courant limit on relative speeds",
+                      lambda t: _relative(crown(t_end=t, **_kw(gap=0.0)))),
+        StabilityCase("dry-floor-relative", "extreme", "the drop on the dry floor, the Courant "
+                      "limit on relative speeds",
+                      lambda t: _relative(crown(t_end=t, **_kw(film=0.0)))),
         StabilityCase("fixed-dt-3x", "extreme", "a user-fixed dt 3 x the acoustic limit: "
                       "refused before the run", _fixed_dt),
     ]
