@@ -93,8 +93,10 @@ def test_a_wall_particle_is_at_rest_and_a_dummy_does_not_count():
     assert relative_speed(pos, vel, kind) == pytest.approx(3.0, rel=1e-6)
 
 
-@pytest.mark.parametrize("dim", [2, 3])
-@pytest.mark.parametrize("how", ["predictor", "list", "walk", "short list"])
+# the pass of its own serves models without viscosity and surface tension (no shipped preset):
+# checked in 2D, where its three ways compile in seconds; the predictor's walk in 2D and 3D
+@pytest.mark.parametrize("dim, how", [(2, "predictor"), (3, "predictor"), (2, "list"),
+                                      (2, "walk"), (2, "short list")])
 def test_jittered_lattice_matches_the_definition(dim, how, monkeypatch):
     rng = np.random.default_rng(11)
     pos = lattice(dim, 14 if dim == 2 else 7)
@@ -114,11 +116,11 @@ def test_jittered_lattice_matches_the_definition(dim, how, monkeypatch):
 def test_the_plane_floor_is_at_rest(path):
     numerics = Numerics(courant_speed="relative", wall_model="plane")
     kind = np.array([FLUID], np.int32)
-    vel = np.array([[4.0, 0.0, -1.0]])
-    near = relative_speed(np.array([[0.0, 0.0, 0.5 * L0]]), vel, kind, numerics, path)
+    vel = np.array([[4.0, -1.0]])          # 2D: the floor is the plane y = 0
+    near = relative_speed(np.array([[0.0, 0.5 * L0]]), vel, kind, numerics, path)
     assert near == pytest.approx(math.sqrt(17.0), rel=1e-6)
     # an isolated particle higher than re above the floor's wall layer: no pair at all
-    far = relative_speed(np.array([[0.0, 0.0, 3.0 * L0]]), vel, kind, numerics, path)
+    far = relative_speed(np.array([[0.0, 3.0 * L0]]), vel, kind, numerics, path)
     assert far == 0.0
 
 
