@@ -33,7 +33,7 @@ def _finish() -> None:
     """At exit: close any GGUI window, then finish Taichi, which writes the kernels compiled
     in this process to Taichi's offline cache. Interpreter shutdown alone does not always
     finish it (it depends on the order in which objects are collected): runs then compiled
-    every kernel afresh each time (BENCHMARKS.md, "offline cache written at exit")."""
+    every kernel afresh each time (BENCHMARKS.md, the 20:48 section)."""
     global _current
     if _current is None:
         return

@@ -63,8 +63,8 @@ class Physics:
 class Numerics:
     courant: float = 0.2            # velocity Courant v dt / l0 (S5)
     # v in the Courant limit: the largest particle speed (the seed's S5), or the largest speed
-    # of a particle relative to its neighbours, walls at rest (relative_speed.py), which also brings in the
-    # approach limit: every particle moves at most ``approach`` l0 a step
+    # of a particle relative to its neighbours, walls at rest (relative_speed.py), which
+    # brings in the approach limit too: every particle moves at most ``approach`` l0 a step
     courant_speed: str = "absolute"
     approach: float = 0.5           # |u| dt / l0 with courant_speed relative
     acoustic: float = 1.0           # acoustic Courant c dt / l0 (S6)
@@ -139,7 +139,7 @@ class Model:
     neighbour_list: bool = True
     cells_per_re: int = 2
     plane_floor: bool = False
-    relative_courant: bool = False   # the relative-speed pass (core/relative_speed.py)
+    relative_courant: bool = False   # the relative speed measured (terms.py, relative_speed.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
