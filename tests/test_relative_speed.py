@@ -1,21 +1,21 @@
 """The relative form of the Courant limit (``numerics.courant_speed: relative``):
 the largest speed of a fluid particle relative to its non-dummy neighbours within re, walls at
-rest (core/relative_speed.py), and the limits it feeds (core/timestep.py).
+rest, measured by the predictor's neighbour walk (core/terms.py), and the limits it feeds
+(core/timestep.py).
 
 Exact values: a block in uniform motion has no relative speed (every force of the step is
 Galilean invariant); a lattice in simple shear u_x = gamma z has 2 gamma l0 (the farthest pair
 along z within re = 2.1 l0 is 2 l0 apart); a fluid particle beside a wall particle at rest has
 its own speed. A jittered lattice with wall and dummy particles is checked against the
-definition written out in numpy over all pairs, as the predictor's walk measures it (viscosity
-or surface tension on) and as the pass of its own does (through the neighbour list, the cell
-walk, a list too short) alike.
+definition written out in numpy over all pairs, with viscosity and surface tension on (as in
+the crown scenes) and with neither (the walk then runs for the relative speed alone).
 """
 import math
 
 import numpy as np
 import pytest
 
-from crowndemo.core import DUMMY, FLUID, WALL, Numerics, Physics, Simulator, neighbours
+from crowndemo.core import DUMMY, FLUID, WALL, Numerics, Physics, Simulator
 from crowndemo.core import timestep
 from crowndemo.core.params import Model, ParameterError, with_values
 
@@ -32,28 +32,27 @@ CAPACITY = 1024      # every scene here fits: one simulator (one compile) per se
 _sims = {}
 
 
-def relative_speed(pos, vel, kind, numerics=None, path="predictor") -> float:
-    """Load the particles and measure: by the predictor's walk (viscosity and surface tension
-    on, as in the crown scenes), or by the pass of its own (neither on) after the density
-    pass has listed the neighbours."""
-    dim = pos.shape[1]
-    liquid = {} if path == "predictor" else {"nu": 0.0, "sigma": 0.0}
+def simulator(dim: int, numerics=None, terms: str = "terms") -> Simulator:
+    """A simulator with viscosity and surface tension ("terms") or neither ("alone"), no
+    gravity, in a 2 m box; one per set-up (one compile)."""
+    liquid = {} if terms == "terms" else {"nu": 0.0, "sigma": 0.0}
     phys = Physics(dim=dim, l0=L0, v_max=1.0, gravity=0.0, **liquid)
     num = numerics or Numerics(courant_speed="relative")
-    key = (dim, num, path, neighbours.SLOTS[dim])
+    key = (dim, num, terms)
     if key not in _sims:
         _sims[key] = Simulator(phys, num, CAPACITY)
         _sims[key].configure(phys, num, ([-1.0] * dim, [1.0] * dim))
-    sim = _sims[key]
+    return _sims[key]
+
+
+def relative_speed(pos, vel, kind, numerics=None, terms="terms") -> float:
+    """Load the particles and measure by the predictor's walk."""
+    sim = simulator(pos.shape[1], numerics, terms)
     sim.load(pos, vel, kind)
     sim.grid.build(sim.lattice.re)
-    if path == "predictor":
-        assert sim.predictor.measures_relative_speed and sim.relative_speed is None
-        sim.predictor.forces()
-        return sim.predictor.relative_speed()
-    assert not sim.predictor.measures_relative_speed
-    sim.pressure.density_and_pressure()
-    return sim.relative_speed.measure()
+    assert sim.predictor.measures_relative_speed and sim.predictor.needs_neighbours
+    sim.predictor.forces()
+    return sim.predictor.relative_speed()
 
 
 def expected(pos, vel, kind) -> float:
@@ -93,11 +92,10 @@ def test_a_wall_particle_is_at_rest_and_a_dummy_does_not_count():
     assert relative_speed(pos, vel, kind) == pytest.approx(3.0, rel=1e-6)
 
 
-# the pass of its own serves models without viscosity and surface tension (no shipped preset):
-# checked in 2D, where its three ways compile in seconds; the predictor's walk in 2D and 3D
-@pytest.mark.parametrize("dim, how", [(2, "predictor"), (3, "predictor"), (2, "list"),
-                                      (2, "walk"), (2, "short list")])
-def test_jittered_lattice_matches_the_definition(dim, how, monkeypatch):
+# without viscosity and surface tension (no shipped preset) checked in 2D only: a 3D compile
+# costs CI half a minute
+@pytest.mark.parametrize("dim, terms", [(2, "terms"), (3, "terms"), (2, "alone")])
+def test_jittered_lattice_matches_the_definition(dim, terms):
     rng = np.random.default_rng(11)
     pos = lattice(dim, 14 if dim == 2 else 7)
     pos = pos + rng.uniform(-0.3, 0.3, pos.shape) * L0
@@ -105,29 +103,45 @@ def test_jittered_lattice_matches_the_definition(dim, how, monkeypatch):
     kind[rng.choice(len(pos), len(pos) // 6, replace=False)] = WALL
     kind[rng.choice(len(pos), len(pos) // 6, replace=False)] = DUMMY
     vel = rng.normal(0.0, 2.0, pos.shape) * (kind == FLUID)[:, None]
-    numerics = Numerics(courant_speed="relative", neighbour_list=how != "walk")
-    if how == "short list":
-        monkeypatch.setitem(neighbours.SLOTS, dim, 3)    # most particles walk the cells
-    got = relative_speed(pos, vel, kind, numerics, "predictor" if how == "predictor" else "pass")
+    got = relative_speed(pos, vel, kind, terms=terms)
     assert got == pytest.approx(expected(pos, vel, kind), rel=1e-5)
 
 
-@pytest.mark.parametrize("path", ["predictor", "pass"])
-def test_the_plane_floor_is_at_rest(path):
+@pytest.mark.parametrize("terms", ["terms", "alone"])
+def test_the_plane_floor_is_at_rest(terms):
     numerics = Numerics(courant_speed="relative", wall_model="plane")
     kind = np.array([FLUID], np.int32)
     vel = np.array([[4.0, -1.0]])          # 2D: the floor is the plane y = 0
-    near = relative_speed(np.array([[0.0, 0.5 * L0]]), vel, kind, numerics, path)
+    near = relative_speed(np.array([[0.0, 0.5 * L0]]), vel, kind, numerics, terms)
     assert near == pytest.approx(math.sqrt(17.0), rel=1e-6)
     # an isolated particle higher than re above the floor's wall layer: no pair at all
-    far = relative_speed(np.array([[0.0, 3.0 * L0]]), vel, kind, numerics, path)
+    far = relative_speed(np.array([[0.0, 3.0 * L0]]), vel, kind, numerics, terms)
     assert far == 0.0
 
 
+def test_a_step_in_uniform_motion_is_bound_by_the_approach_limit():
+    """No relative speed, so the Courant limit is out of play and |u| dt = C_a l0 binds
+    (c = 15 m/s: the acoustic limit l0 / c is longer, and |u| < c keeps the health check
+    quiet). The walk runs for this alone."""
+    sim = simulator(2, terms="alone")
+    fast = Physics(dim=2, l0=L0, v_max=1.0, gravity=0.0, nu=0.0, sigma=0.0, sound_speed=15.0)
+    base = sim.physics
+    sim.configure(fast, sim.numerics)
+    try:
+        pos = lattice(2, 10)
+        u = np.array([6.0, -8.0])                 # |u| = 10 m/s
+        sim.load(pos, np.tile(u, (len(pos), 1)), np.full(len(pos), FLUID, np.int32))
+        dt = sim.step()
+    finally:
+        sim.configure(base, sim.numerics)
+    assert dt == pytest.approx(0.5 * L0 / 10.0, rel=1e-5)
+    assert sim.stats.binding["approach"] == 1
+
+
 def test_not_compiled_without_it():
-    phys = Physics(dim=2, l0=L0, v_max=1.0)
-    sim = Simulator(phys, Numerics(), 100)
-    assert sim.relative_speed is None and not sim.predictor.measures_relative_speed
+    phys = Physics(dim=2, l0=L0, v_max=1.0, nu=0.0, sigma=0.0)
+    sim = Simulator(phys, Numerics(collision=0.0), 100)
+    assert not sim.predictor.measures_relative_speed and not sim.predictor.needs_neighbours
     assert sim.predictor.rel2 is None
     assert not Model.of(phys, Numerics()).relative_courant
 

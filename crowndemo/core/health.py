@@ -4,7 +4,7 @@ kinetic + gravitational energy. ``check`` turns a broken limit into an ``Instabi
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
+from typing import Dict, List
 
 import numpy as np
 import taichi as ti
@@ -29,6 +29,25 @@ def finite(x) -> bool:
     return ok
 
 
+@ti.func
+def fluid_max(state: ti.template(), values: ti.template(), blocks: ti.template(),
+              out: ti.template()):
+    """out[None] = the largest values[i] >= 0 over the fluid particles: per block of particles,
+    then over the blocks (no contended atomics). Called at a kernel's top level."""
+    n = state.n[None]
+    for b in range((n + BLOCK - 1) // BLOCK):
+        top = 0.0
+        for i in range(b * BLOCK, ti.min(n, (b + 1) * BLOCK)):
+            if state.kind[i] == FLUID:
+                top = ti.max(top, values[i])
+        blocks[b] = top
+    for _ in range(1):
+        top = 0.0
+        for b in range((n + BLOCK - 1) // BLOCK):
+            top = ti.max(top, blocks[b])
+        out[None] = top
+
+
 def exit_reasons(dim: int) -> List[str]:
     """Reason codes: 0 none, 1 + 2 axis + side for 'left through x-' etc."""
     return ["none"] + [f"left through {AXES[a]}{s}" for a in range(dim) for s in "-+"]
@@ -49,7 +68,6 @@ class InstabilityError(RuntimeError):
 @dataclass
 class HealthReport:
     max_speed: float = 0.0
-    max_relative_speed: Optional[float] = None   # measured with courant_speed: relative
     max_density_excess: float = 0.0
     kinetic: float = 0.0
     potential: float = 0.0

@@ -11,7 +11,7 @@ from typing import Optional
 
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
-COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; relative_speed.py)
+COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; terms.py)
 
 
 class ParameterError(ValueError):
@@ -63,7 +63,7 @@ class Physics:
 class Numerics:
     courant: float = 0.2            # velocity Courant v dt / l0 (S5)
     # v in the Courant limit: the largest particle speed (the seed's S5), or the largest speed
-    # of a particle relative to its neighbours, walls at rest (relative_speed.py), which
+    # of a particle relative to its neighbours, walls at rest (terms.py), which
     # brings in the approach limit too: every particle moves at most ``approach`` l0 a step
     courant_speed: str = "absolute"
     approach: float = 0.5           # |u| dt / l0 with courant_speed relative
@@ -139,7 +139,7 @@ class Model:
     neighbour_list: bool = True
     cells_per_re: int = 2
     plane_floor: bool = False
-    relative_courant: bool = False   # the relative speed measured (terms.py, relative_speed.py)
+    relative_courant: bool = False   # the relative speed measured (terms.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":

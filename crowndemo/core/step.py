@@ -21,7 +21,6 @@ from .operators import Operators
 from .params import Model, Numerics, Physics
 from .plane_floor import PlaneFloor
 from .pressure import Pressure
-from .relative_speed import RelativeSpeed
 from .state import FLUID, ParticleState
 from .terms import Predictor
 
@@ -115,12 +114,6 @@ class Simulator:
         self.predictor = Predictor(self.model, self.grid, self.coef, self.floor)
         self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
         self.health = Health(self.state, self.coef)
-        # the relative Courant limit's speed: measured by the predictor's walk where it walks
-        # (viscosity or surface tension), else by a pass of its own after each step
-        self.relative_speed = None
-        if self.model.relative_courant and not self.predictor.measures_relative_speed:
-            self.relative_speed = RelativeSpeed(self.grid, self.coef, self.pressure.neighbours,
-                                                self.floor)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0
@@ -158,7 +151,7 @@ class Simulator:
         self.n_fluid = int((np.asarray(kind) == FLUID).sum())
         self.health.reset()
         self.stats = RunStats()
-        self._last = self._measure(pairs=False)   # no neighbour pairs yet (the speed bounds them)
+        self._last = self._measure()
         self.stats.energy_start = self._last.energy
 
     def save_state(self) -> dict:
@@ -204,7 +197,7 @@ class Simulator:
             self.grid.build(re, reorder=reorder)        # neighbours at r^k
             self._stage("grid")
         self.predictor.forces()                         # S14 at r^k
-        relative = self._last.max_relative_speed        # the relative Courant limit's speed
+        relative = None                                 # the relative Courant limit's speed
         if self.predictor.measures_relative_speed:
             relative = self.predictor.relative_speed()  # at r^k, u^k: the walk just read it
         dt, binding = timestep.choose(self.physics, self.numerics, self.model,
@@ -240,10 +233,8 @@ class Simulator:
             raise
         return dt
 
-    def _measure(self, pairs: bool = True) -> HealthReport:
+    def _measure(self) -> HealthReport:
         report = self.health.measure()
-        if self.relative_speed is not None and pairs:
-            report.max_relative_speed = self.relative_speed.measure()
         self.stats.note(report)
         return report
 
@@ -287,5 +278,4 @@ class Simulator:
     def memory_bytes(self) -> int:
         return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
                 + self.predictor.nbytes() + self.pressure.nbytes()
-                + (self.floor.nbytes() if self.floor else 0)
-                + (self.relative_speed.nbytes() if self.relative_speed else 0))
+                + (self.floor.nbytes() if self.floor else 0))

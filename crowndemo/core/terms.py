@@ -2,8 +2,19 @@
 the particle collision model on u* before the positions move.
 
 The terms a scene does not use are not compiled in (``ti.static`` on the model's flags); if
-neither viscosity, surface tension nor collisions are on, the predictor is a plain element-wise
-update with no neighbour walk.
+neither viscosity, surface tension, collisions nor the relative Courant limit are on, the
+predictor is a plain element-wise update with no neighbour walk.
+
+The relative Courant limit (``numerics.courant_speed: relative``) takes its speed from the
+predictor's walk, which reads every u_j - u_i at r^k before dt is chosen: the largest speed of
+a fluid particle relative to its non-dummy neighbours within re, walls at rest (a particle
+within re of the analytic plane floor's wall layer counts its own speed). Every force of the
+step depends on relative positions and velocities only (S9-S13, S22, the collision model), so
+the configuration changes, per step, by dt times that speed: a spray droplet flying at 3 U
+changes nothing around it. A particle with no neighbour yet is bound by the approach limit
+instead (timestep.py): |u| dt <= C_a l0, so two particles closing head-on from beyond re end a
+step at least re - 2 C_a l0 = 1.1 l0 apart (C_a = 0.5, re = 2.1 l0), in range and in the
+relative limit before they can come closer than the lattice spacing.
 
 Why collisions (measured on the ``quick`` crown, 4 mm drop at 8 m/s, l0 = 0.4 mm): particles on
 the free surface have P = 0 (M3), so nothing repels two of them that approach; in the splash
@@ -21,10 +32,10 @@ import taichi as ti
 
 from .coefficients import Coefficients
 from .grid import CellGrid
+from .health import BLOCK, fluid_max
 from .operators import laplacian_pair, weight
 from .params import Model
 from .plane_floor import FLOOR_V, PlaneFloor
-from .relative_speed import BLOCK, fluid_max
 from .state import DUMMY, FLUID
 
 CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per particle (rare: the
@@ -63,13 +74,12 @@ class Predictor:
 
     @property
     def lists_close_pairs(self) -> bool:
-        return self.model.collision and self._pair_terms
+        return self.model.collision and self._walks
 
     @property
     def measures_relative_speed(self) -> bool:
-        """The speed of the relative Courant limit (relative_speed.py) measured by this walk,
-        which reads every u_j - u_i at r^k anyway, before dt is chosen."""
-        return self.model.relative_courant and self._pair_terms
+        """The speed of the relative Courant limit measured by the walk (module docstring)."""
+        return self.model.relative_courant
 
     def relative_speed(self) -> float:
         """max |u_j - u_i| over the pairs of the last ``forces`` (m/s; walls at rest)."""
@@ -86,11 +96,14 @@ class Predictor:
 
     @property
     def needs_neighbours(self) -> bool:
-        return self.model.viscosity or self.model.surface_tension or self.model.collision
+        return self._walks or self.model.collision
 
     @property
-    def _pair_terms(self) -> bool:
-        return self.model.viscosity or self.model.surface_tension
+    def _walks(self) -> bool:
+        """``forces`` walks the neighbours: for viscosity, surface tension or the relative
+        speed (the collision pass walks on its own where nothing else does)."""
+        return (self.model.viscosity or self.model.surface_tension
+                or self.model.relative_courant)
 
     @ti.func
     def _collision_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -144,11 +157,10 @@ class Predictor:
     @ti.kernel
     def forces(self):
         """a* = nu <lap u> + g + (C/m) sum grad potential (S14) at r^k, into scratch_vec (no
-        work without viscosity and surface tension: ``accelerate`` adds g alone). With the
-        relative Courant limit, the largest |u_j - u_i| of the walk's pairs (non-dummy j
-        within re; a particle within re of the plane floor's wall layer counts its own speed):
-        per particle into scratch_float, then reduced per block and over the blocks."""
-        if ti.static(self._pair_terms):
+        work without a walk: ``accelerate`` adds g alone). With the relative Courant limit,
+        the largest |u_j - u_i| of the walk's pairs (module docstring): per particle into
+        scratch_float, then reduced per block and over the blocks."""
+        if ti.static(self._walks):
             visc = self.coef.nu[None] * (2.0 * self.dim) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
             for at in range(self.state.n[None]):
@@ -184,8 +196,8 @@ class Predictor:
 
     @ti.kernel
     def accelerate(self, dt: float):
-        """u* = u + dt a* (S15), a* from ``forces``; g alone without pair terms."""
-        if ti.static(self._pair_terms):
+        """u* = u + dt a* (S15), a* from ``forces``; g alone where it did not walk."""
+        if ti.static(self._walks):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
                 if self.state.kind[i] == FLUID:

@@ -17,8 +17,8 @@ def limits(physics: Physics, numerics: Numerics, model: Model, speed: float,
     yet: the maximum speed, as in the seed's form).
 
     courant:   C_v l0 / v        (S5, S7); v = the speed, or the relative speed
-                                 (relative_speed.py)
-    approach:  C_a l0 / v        (with the relative speed only: relative_speed.py)
+                                 (measured by the predictor's walk, terms.py)
+    approach:  C_a l0 / v        (with the relative speed only; terms.py says why)
     acoustic:  C_c l0 / c        (S6, S8)
     viscous:   k_nu l0^2 / nu    (M1; only when viscosity is compiled in)
     capillary: k_st sqrt(rho l0^3 / (2 pi sigma))  (M1; only with surface tension)

@@ -261,6 +261,6 @@ def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
         return replace(numerics, pressure_gradient=variant.split("=", 1)[1])
     if variant == "plane-floor":        # the analytic floor instead of its particle layers
         return replace(numerics, wall_model="plane")
-    if variant == "relative-courant":   # the crown presets' Courant limit (relative_speed.py)
+    if variant == "relative-courant":   # the crown presets' Courant limit (core/terms.py)
         return replace(numerics, courant_speed="relative")
     return numerics

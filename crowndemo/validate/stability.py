@@ -87,7 +87,7 @@ def _two_drops(t_end: float) -> Scene:
 
 def _relative(sc: Scene) -> Scene:
     """The same scene with the Courant limit on relative speeds (the crown presets' setting,
-    core/relative_speed.py): fewer, larger steps once the splash flies."""
+    core/terms.py): fewer, larger steps once the splash flies."""
     sc.numerics = replace(sc.numerics, courant_speed="relative")
     return sc
 
