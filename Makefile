@@ -30,8 +30,10 @@ vulkan:
 demo: setup
 	$(VENV)/bin/crowndemo record 2m-drop
 
+# One pytest-xdist worker per core (at most 4), each test file on one worker: most of the
+# suite's time is compiling kernels, one core per process, and a file's tests share them.
 test: setup
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile
 
 # The full validation suite (issue 5): every case at three resolutions and its settings
 # variants, the stability suite and the seed's crown verdicts; rewrites VALIDATION.md.
