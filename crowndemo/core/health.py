@@ -93,6 +93,7 @@ class Health:
         blocks = (state.capacity + BLOCK - 1) // BLOCK
         self.block_stats = ti.Vector.field(4, float, blocks)
         self.block_bad = ti.field(ti.i32, blocks)
+        self.block_left = ti.field(ti.i32, (blocks, 2 * self.dim))    # parked, per exit reason
 
     def reset(self) -> None:
         self.istats.fill(0)
@@ -110,9 +111,12 @@ class Health:
 
     @ti.kernel
     def _reduce(self):
-        """Per block of particles, then over the blocks: no contended atomics on the stats."""
+        """Per block of particles, then over the blocks, with no atomic on a stat: on Taichi
+        1.7.4's Vulkan arch (lavapipe) an atomic add on the counters inside either loop left
+        the whole loop's results at zero (max speed 0 while the drop fell at 8 m/s)."""
         for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
             speed2, excess, kinetic, potential, bad_count = 0.0, 0.0, 0.0, 0.0, 0
+            left = ti.Vector.zero(ti.i32, 2 * self.dim)
             m, n0 = self.coef.mass[None], self.coef.n0[None]
             g = self.coef.gravity[None]
             for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
@@ -135,7 +139,9 @@ class Health:
                             self.state.kind[i] = GONE
                             self.state.exit_reason[i] = reason
                             self.state.vel[i] = ti.Vector.zero(float, self.dim)
-                            ti.atomic_add(self.istats[1 + reason], 1)
+                            for k in ti.static(range(2 * self.dim)):
+                                if reason == 1 + k:
+                                    left[k] += 1
                         else:
                             u2 = u.dot(u)
                             speed2 = ti.max(speed2, u2)
@@ -144,9 +150,12 @@ class Health:
                             potential -= m * g.dot(x)
             self.block_stats[b] = ti.Vector([speed2, excess, kinetic, potential])
             self.block_bad[b] = bad_count
+            for k in ti.static(range(2 * self.dim)):
+                self.block_left[b, k] = left[k]
         for _ in range(1):
             total = ti.Vector([0.0, 0.0, 0.0, 0.0])
             bad_total = 0
+            left = ti.Vector.zero(ti.i32, 2 * self.dim)
             for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
                 v = self.block_stats[b]
                 total[F_SPEED2] = ti.max(total[F_SPEED2], v[F_SPEED2])
@@ -154,8 +163,12 @@ class Health:
                 total[F_KINETIC] += v[F_KINETIC]
                 total[F_POTENTIAL] += v[F_POTENTIAL]
                 bad_total += self.block_bad[b]
+                for k in ti.static(range(2 * self.dim)):
+                    left[k] += self.block_left[b, k]
             for k in ti.static(range(4)):
                 self.fstats[k] = total[k]
+            for k in ti.static(range(2 * self.dim)):     # reason 1 + k, cumulative
+                self.istats[2 + k] = self.istats[2 + k] + left[k]
             self.istats[I_NONFINITE] = bad_total
 
     def measure(self) -> HealthReport:
