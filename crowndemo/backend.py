@@ -20,6 +20,7 @@ class Backend:
     precision: str
     seed: int
     single_thread: bool
+    fast_compile: bool = False    # Taichi's advanced IR optimisations off on the CPU arch
 
 
 _current: Optional[Backend] = None
@@ -49,42 +50,54 @@ def _arch_object(name: str):
 
 
 def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
-         single_thread: bool = False, quiet: bool = True) -> Backend:
+         single_thread: bool = False, quiet: bool = True,
+         fast_compile: Optional[bool] = None) -> Backend:
     """Start Taichi once per process.
 
-    ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` tries a GPU
-    and falls back to the CPU. ``single_thread`` makes CPU runs bit-reproducible. A second
-    call with the same settings is a no-op; with other settings Taichi is reset.
+    ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` is CUDA where
+    Taichi finds it, else the CPU. ``single_thread`` makes CPU runs bit-reproducible.
+    ``fast_compile`` (None: ``$CROWNDEMO_FAST_COMPILE`` = 1) turns Taichi's advanced IR
+    optimisations off on the CPU arch: the 3D crown step compiles in 13-19 s instead of
+    46-55 s and runs 5-10 % slower (BENCHMARKS.md, "Compiling"); no effect on other archs.
+    A second call with the same settings is a no-op; with other settings Taichi is reset.
     """
     global _current
+    if fast_compile is None:
+        fast_compile = os.environ.get("CROWNDEMO_FAST_COMPILE", "") == "1"
     arch = (arch or os.environ.get("CROWNDEMO_ARCH") or "cpu").lower()
     if arch not in ARCHS:
         raise BackendError(f"arch {arch!r} is not one of {', '.join(ARCHS)} "
                            "(--arch or CROWNDEMO_ARCH)")
     if precision not in PRECISIONS:
         raise BackendError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}")
-    wanted = (arch, precision, int(seed), bool(single_thread))
+    wanted = (arch, precision, int(seed), bool(single_thread), bool(fast_compile))
     if _current is not None and (_current.arch, _current.precision, _current.seed,
-                                 _current.single_thread) == wanted:
+                                 _current.single_thread, _current.fast_compile) == wanted:
         return _current
     if _current is not None:
         ti.reset()
     else:
         atexit.register(_finish)    # once: _current is None only before the first init
+    target = arch
+    if arch == "auto":
+        # CUDA, else the CPU; never Taichi's other GPU backends: without a GPU, Vulkan is
+        # Mesa's software driver (lavapipe, which make installs for the renderer), about 20
+        # times slower than the CPU arch (BENCHMARKS.md, "Compiling")
+        from taichi.lang.misc import is_arch_supported
+        target = "cuda" if is_arch_supported(ti.cuda) else "cpu"
     kwargs = dict(default_fp=ti.f64 if precision == "f64" else ti.f32,
                   default_ip=ti.i32, random_seed=int(seed), offline_cache=True,
+                  advanced_optimization=not (fast_compile and target == "cpu"),
                   log_level=ti.WARN if quiet else ti.INFO)
     if single_thread:
         kwargs["cpu_max_num_threads"] = 1
-    if arch == "auto":
-        ti.init(arch=ti.gpu, **kwargs)  # Taichi falls back to the CPU when no GPU works
-    else:
-        ti.init(arch=_arch_object(arch), **kwargs)
-        if arch in ("cuda", "vulkan", "gpu") and ti.lang.impl.current_cfg().arch in (ti.x64, ti.arm64):
-            raise BackendError(f"arch {arch!r} was asked for but Taichi found no such device "
-                               "(it fell back to the CPU); use --arch cpu")
+    ti.init(arch=_arch_object(target), **kwargs)    # falls back to the CPU if CUDA fails
+    if arch in ("cuda", "vulkan", "gpu") and ti.lang.impl.current_cfg().arch in (ti.x64, ti.arm64):
+        raise BackendError(f"arch {arch!r} was asked for but Taichi found no such device "
+                           "(it fell back to the CPU); use --arch cpu")
     resolved = str(ti.lang.impl.current_cfg().arch).split(".")[-1]
-    _current = Backend(arch, resolved, precision, int(seed), bool(single_thread))
+    _current = Backend(arch, resolved, precision, int(seed), bool(single_thread),
+                       bool(fast_compile))
     return _current
 
 

@@ -134,7 +134,7 @@ def _backend_and_memory(be, sim) -> Dict:
     """The result fields every benchmark shares: where it ran, and the simulator's bytes."""
     total = sim.state.count
     return {"arch": be.arch, "resolved_arch": be.resolved, "precision": be.precision,
-            "single_thread": be.single_thread,
+            "single_thread": be.single_thread, "fast_compile": be.fast_compile,
             "bytes_per_particle": sim.memory_bytes() / total, "memory_bytes": sim.memory_bytes()}
 
 
@@ -249,7 +249,13 @@ def _preset_row(r: Dict) -> List[str]:
             str(r["steps"]), f"{1e3 * r['simulated_s']:.3g} of {1e3 * r['t_end_s']:.3g}",
             f"{r['run_s']:.1f}", f"{r['startup_s']:.1f}", f"{r['particle_steps_per_s']:.3e}",
             f"{r['bytes_per_particle']:.0f}", arch,
-            r["precision"] + (" 1-thread" if r["single_thread"] else "")]
+            _build(r)]
+
+
+def _build(r: Dict) -> str:
+    """The precision column: the float type, and how the kernels were run and built."""
+    return (r["precision"] + (" 1-thread" if r["single_thread"] else "")
+            + (" fast-compile" if r.get("fast_compile") else ""))
 
 
 def _presets(results: Sequence[Dict]) -> bool:
@@ -261,7 +267,7 @@ def _row(r: Dict) -> List[str]:
     return [f"{r['particles']['fluid']:,}", f"{r['particles']['total']:,}", str(r["steps"]),
             f"{r['seconds']:.3f}", f"{r['particle_steps_per_s']:.3e}", f"{r['compile_s']:.2f}",
             f"{r['bytes_per_particle']:.0f}", arch,
-            r["precision"] + (" 1-thread" if r["single_thread"] else "")]
+            _build(r)]
 
 
 def _labelled(results: Sequence[Dict]) -> bool:
@@ -428,7 +434,8 @@ def record(results: Sequence[Dict], command: str, path: str) -> str:
     lines = [f"## {now}", "",
              f"- machine: {m['cpu']}, {cores}" + (f"; GPU: {m['gpu']}" if "gpu" in m else ""),
              f"- arch: {arch}; precision: {be['precision']}"
-             + ("; single thread" if be["single_thread"] else ""),
+             + ("; single thread" if be["single_thread"] else "")
+             + ("; --fast-compile" if be.get("fast_compile") else ""),
              f"- software: taichi {m['taichi']}, python {m['python']}, numpy {m['numpy']}, "
              f"{m['os']}",
              f"- command: `{command}`",

@@ -47,13 +47,17 @@ def backend_options() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(add_help=False)
     g = p.add_argument_group("backend options")
     g.add_argument("--arch", choices=ARCHS, default=None,
-                   help="Taichi backend; auto tries a GPU and falls back to the CPU "
+                   help="Taichi backend; auto tries CUDA and falls back to the CPU "
                         "(default: $CROWNDEMO_ARCH, else cpu)")
     g.add_argument("--precision", choices=PRECISIONS, default="f32",
                    help="float precision of every field and kernel (default: f32)")
     g.add_argument("--seed", type=int, default=0, help="Taichi random seed (default: 0)")
     g.add_argument("--single-thread", action="store_true",
                    help="one CPU thread: bit-identical results from run to run")
+    g.add_argument("--fast-compile", action="store_true", default=None,
+                   help="CPU arch: compile in about a third of the time (Taichi's advanced "
+                        "IR optimisations off), steps 5-10 %% slower; for first and short "
+                        "runs (default: $CROWNDEMO_FAST_COMPILE=1, else off)")
     return p
 
 
@@ -63,7 +67,8 @@ def start_backend(args):
     from .. import backend
     # ti.init prints "[Taichi] Starting on arch=..." on stdout: send it to stderr
     with contextlib.redirect_stdout(sys.stderr):
-        return backend.init(args.arch, args.precision, args.seed, args.single_thread)
+        return backend.init(args.arch, args.precision, args.seed, args.single_thread,
+                            fast_compile=args.fast_compile)
 
 
 def fmt_counts(counts: Dict[str, int]) -> str:

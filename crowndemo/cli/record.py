@@ -71,6 +71,8 @@ def _resume_command(r, args) -> str:
             words += [f"--{opt}", getattr(args, opt)]
     if args.single_thread:
         words.append("--single-thread")
+    if args.fast_compile:
+        words.append("--fast-compile")
     return " ".join(shlex.quote(w) for w in words + ["--resume"])
 
 

@@ -77,11 +77,13 @@ def run_suite(cases: Iterable[Case], quick: bool = False, variants: bool = True,
     rows: List[Row] = []
     for case, scale, variant in jobs:
         if variant == "f64" and backend.current().precision != "f64":
-            backend.init(be.arch, "f64", be.seed, be.single_thread)
+            backend.init(be.arch, "f64", be.seed, be.single_thread,
+                         fast_compile=be.fast_compile)
         row = run_one(case, scale, variant)
         rows.append(row)
         if on_row:
             on_row(row)
     if backend.current().precision != be.precision:
-        backend.init(be.arch, be.precision, be.seed, be.single_thread)
+        backend.init(be.arch, be.precision, be.seed, be.single_thread,
+                     fast_compile=be.fast_compile)
     return rows

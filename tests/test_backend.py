@@ -1,0 +1,51 @@
+"""The backend choice (crowndemo.backend): ``auto`` never lands on Mesa's software Vulkan;
+``--fast-compile`` turns Taichi's advanced IR optimisations off on the CPU arch only
+(BENCHMARKS.md, "Compiling": the 3D crown step compiles in about a third of the time)."""
+import taichi as ti
+from taichi.lang.misc import is_arch_supported
+
+from crowndemo import backend
+from crowndemo.cli import main
+
+
+def advanced() -> bool:
+    return bool(ti.lang.impl.current_cfg().advanced_optimization)
+
+
+def test_auto_is_cuda_or_the_cpu():
+    try:
+        b = backend.init("auto")
+        if is_arch_supported(ti.cuda):
+            assert b.resolved == "cuda"
+        else:        # even where a (software) Vulkan device works, as on the CI machine
+            assert b.resolved in ("x64", "arm64")
+    finally:
+        backend.init("cpu")
+
+
+def test_fast_compile_on_the_cpu_only(monkeypatch):
+    monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
+    try:
+        assert backend.init("cpu").fast_compile is False and advanced()
+        assert backend.init("cpu", fast_compile=True).fast_compile and not advanced()
+        monkeypatch.setenv("CROWNDEMO_FAST_COMPILE", "1")
+        assert backend.init("cpu").fast_compile and not advanced()
+        try:
+            backend.init("vulkan", fast_compile=True)
+        except backend.BackendError:
+            pass                          # no Vulkan device here
+        else:
+            assert advanced()             # other archs keep Taichi's optimisations
+    finally:
+        monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
+        backend.init("cpu")
+
+
+def test_the_bench_says_how_it_compiled(capsys, monkeypatch):
+    monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
+    try:
+        assert main(["bench", "--n", "500", "--steps", "1", "--fast-compile",
+                     "--no-stages"]) == 0
+        assert "f32 fast-compile" in capsys.readouterr().out
+    finally:
+        backend.init("cpu")
