@@ -120,7 +120,8 @@ NUMERICS_KEYS = {
     "courant": number("velocity Courant number v dt / l0 (S5)", "", **_C),
     "courant_speed": Field("choice", "v of the Courant limit: the largest particle speed "
                            "(S5), or the largest speed relative to neighbours, walls at rest "
-                           "(measured by the predictor's walk, core/terms.py)", choices=COURANT_SPEEDS),
+                           "(measured by the predictor's walk, core/terms.py)",
+                           choices=COURANT_SPEEDS),
     "approach": number("with courant_speed relative: the most a particle moves in a step, "
                        "a fraction of l0", "", **_C),
     "acoustic": number("acoustic Courant number c dt / l0 (S6)", "", **_C),

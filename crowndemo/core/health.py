@@ -112,8 +112,9 @@ class Health:
     @ti.kernel
     def _reduce(self):
         """Per block of particles, then over the blocks, with no atomic on a stat: on Taichi
-        1.7.4's Vulkan arch (lavapipe) an atomic add on the counters inside either loop left
-        the whole loop's results at zero (max speed 0 while the drop fell at 8 m/s)."""
+        1.7.4's Vulkan arch (lavapipe) an atomic add on the counters inside either loop spoiled
+        that whole loop's results (max speed 0 while the drop fell at 8 m/s; one block's exit
+        counts of three; tests/test_gpu_arch.py)."""
         for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
             speed2, excess, kinetic, potential, bad_count = 0.0, 0.0, 0.0, 0.0, 0
             left = ti.Vector.zero(ti.i32, 2 * self.dim)
