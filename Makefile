@@ -28,7 +28,7 @@ vulkan:
 	fi
 
 demo: setup
-	$(VENV)/bin/crowndemo record 2m-drop
+	$(VENV)/bin/crowndemo record 2m-drop --fast-compile
 
 # One pytest-xdist worker per core (at most 4), each test file on one worker: most of the
 # suite's time is compiling kernels, one core per process, and a file's tests share them.
