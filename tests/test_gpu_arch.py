@@ -1,18 +1,18 @@
-"""The step on a GPU arch: Taichi's Vulkan backend, which Mesa's software driver (lavapipe,
-installed by ``make`` for the renderer) runs where there is no GPU. So the GPU code path (one
-device task per kernel loop, no CPU-thread spreading, SPIR-V instead of LLVM) is checked on
-every machine, not only in sessions lent a CUDA device. Skipped, saying why, where Taichi finds
-no Vulkan device.
+"""The step on the GPU archs: CUDA where there is one, and Taichi's Vulkan backend, which Mesa's
+software driver (lavapipe, installed by ``make`` for the renderer) runs where there is no GPU.
+So the GPU code path (one device task per kernel loop, no CPU-thread spreading; PTX or
+SPIR-V instead of the CPU's code) is checked on every machine, and on CUDA where a session has
+a GPU. An arch that Taichi does not find is skipped, saying why.
 
 - The health reductions against numpy on a state with particles outside the domain: the
   counts of parked particles per exit reason are exact integers, the maximum speed and kinetic
   energy float sums. (On Vulkan an atomic add on the counters once zeroed whole reductions:
   the crown's drop fell at 8 m/s while the health report said 0.)
-- The ``quick-2d`` and ``quick`` (3D) crowns, 20 steps, on Vulkan and on the CPU: the same
-  discrete equations on both, so the runs differ by float32 rounding only (summation order,
-  fused multiply-adds), amplified over the steps; a missing term or a broken pass differs at
-  order one. The CPU side compiles with ``fast_compile`` (the same equations; the 3D step
-  compiles in a third of the time).
+- The ``quick-2d`` and ``quick`` (3D) crowns, 20 steps, on the GPU arch and on the CPU: the
+  same discrete equations on both, so the runs differ by float32 rounding only (summation
+  order, fused multiply-adds), amplified over the steps; a missing term or a broken pass
+  differs at order one. The CPU side compiles with ``fast_compile`` (the same equations; the
+  3D step compiles in a third of the time).
 """
 import numpy as np
 import pytest
@@ -60,25 +60,41 @@ def parked_state() -> dict:
     return {"pos": pos, "vel": vel, "report": health.measure()}
 
 
+GPU_ARCHS = ("vulkan", "cuda")
+
+
 @pytest.fixture(scope="module")
 def runs():
+    """Per GPU arch: the parked-state report and the crown runs, or why it was skipped; and
+    the CPU's crown runs."""
+    out = {}
     try:
-        backend.init("vulkan")
-    except BackendError as e:
-        backend.init("cpu")
-        pytest.skip(f"no Vulkan device for Taichi: {e}")
-    try:
-        out = {"parked": parked_state()}
-        out.update({("vulkan", p): crown_run(p) for p in PRESETS})
-        backend.init("cpu", fast_compile=True)
-        out.update({("cpu", p): crown_run(p) for p in PRESETS})
+        for arch in GPU_ARCHS:
+            try:
+                backend.init(arch)
+            except BackendError as e:
+                out[arch] = f"no {arch} device for Taichi: {e}"
+                continue
+            out[(arch, "parked")] = parked_state()
+            out.update({(arch, p): crown_run(p) for p in PRESETS})
+        if any((a, "parked") in out for a in GPU_ARCHS):
+            backend.init("cpu", fast_compile=True)
+            out.update({("cpu", p): crown_run(p) for p in PRESETS})
     finally:
         backend.init("cpu")          # the session's backend (resets Taichi)
     return out
 
 
-def test_health_reductions_on_vulkan(runs):
-    pos, vel, report = runs["parked"]["pos"], runs["parked"]["vel"], runs["parked"]["report"]
+def on(runs: dict, arch: str, what: str):
+    if arch in runs:
+        pytest.skip(runs[arch])
+    return runs[(arch, what)]
+
+
+@pytest.mark.parametrize("arch", GPU_ARCHS)
+def test_health_reductions_on_the_gpu_arch(runs, arch):
+    parked = on(runs, arch, "parked")
+    pos, vel, report = parked["pos"], parked["vel"], parked["report"]
     # the exit reason as Health gives it: the last axis out wins, lo before hi on an axis
     reason = np.zeros(len(pos), int)
     for k in range(2):
@@ -94,9 +110,10 @@ def test_health_reductions_on_vulkan(runs):
     assert report.nonfinite == 0
 
 
+@pytest.mark.parametrize("arch", GPU_ARCHS)
 @pytest.mark.parametrize("preset", PRESETS)
-def test_crown_steps_on_vulkan_match_the_cpu(runs, preset):
-    gpu, cpu = runs[("vulkan", preset)], runs[("cpu", preset)]
+def test_crown_steps_on_the_gpu_arch_match_the_cpu(runs, arch, preset):
+    gpu, cpu = on(runs, arch, preset), runs[("cpu", preset)]
     assert gpu["time"] == pytest.approx(cpu["time"], rel=ROUNDING)   # the same dt, step by step
     a, b = gpu["snap"], cpu["snap"]
     assert np.array_equal(a["kind"], b["kind"])
@@ -109,7 +126,7 @@ def test_crown_steps_on_vulkan_match_the_cpu(runs, preset):
     # rho c^2 eps, so the pressures agree on that scale
     assert np.abs(b["pressure"][fluid]).max() > 0.0
     assert np.abs(a["pressure"] - b["pressure"])[fluid].max() < ROUNDING * gpu["rho_c2"]
-    # the health report on Vulkan: what numpy reads from the same particles
+    # the health report on the GPU arch: what numpy reads from the same particles
     u = np.linalg.norm(a["vel"][a["kind"] == FLUID].astype(np.float64), axis=1)
     assert gpu["health"].max_speed == pytest.approx(u.max(), rel=1e-5)
     assert gpu["health"].kinetic == pytest.approx(0.5 * gpu["mass"] * (u ** 2).sum(), rel=1e-4)
