@@ -1,7 +1,7 @@
 """Dynamic cell grid: bounds follow the live particles, counting sort, neighbour walk.
 
 The grid is rebuilt from scratch whenever positions change: bounds by reduction, cell count per
-cell, a blocked two-level prefix sum that runs on the CPU and GPU archs alike (Taichi's
+cell, a blocked prefix sum that runs on the CPU and GPU archs alike (blocks.py; Taichi's
 PrefixSumExecutor does not run on the CPU), then a scatter into ``order`` (particle indices in
 cell order). Cells have side >= re/k (k = ``cells_per_re``), so every neighbour within re lies
 in the (2k + 1)^d cells around; k = 2 visits fewer candidate pairs than k = 1 (BENCHMARKS.md).
@@ -11,9 +11,8 @@ grows: the walk stays exact, only more candidate pairs are visited.
 
 import taichi as ti
 
+from .blocks import BLOCK, blocks_for, exclusive_scan, groups_for, larger, reduce_blocks, smaller
 from .state import GONE, ParticleState
-
-SCAN_BLOCK = 1024
 
 
 @ti.data_oriented
@@ -35,10 +34,15 @@ class CellGrid:
         self.n_parked = ti.field(ti.i32, shape=())
         self.cell_count = ti.field(ti.i32, self.max_cells)
         self.cell_start = ti.field(ti.i32, self.max_cells + 1)
-        self.block_sum = ti.field(ti.i32, (self.max_cells + SCAN_BLOCK - 1) // SCAN_BLOCK)
-        particle_blocks = (state.capacity + SCAN_BLOCK - 1) // SCAN_BLOCK
+        self.block_sum = ti.field(ti.i32, blocks_for(self.max_cells))
+        self.group_sum = ti.field(ti.i32, groups_for(blocks_for(self.max_cells)))
+        particle_blocks = blocks_for(state.capacity)
         self.block_lo = ti.Vector.field(d, float, particle_blocks)
         self.block_hi = ti.Vector.field(d, float, particle_blocks)
+        self.group_lo = ti.Vector.field(d, float, groups_for(particle_blocks))
+        self.group_hi = ti.Vector.field(d, float, groups_for(particle_blocks))
+        self.live_lo = ti.Vector.field(d, float, shape=())
+        self.live_hi = ti.Vector.field(d, float, shape=())
         self.particle_cell = ti.field(ti.i32, state.capacity)
         self.rank = ti.field(ti.i32, state.capacity)
         self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
@@ -55,8 +59,8 @@ class CellGrid:
     def nbytes(self) -> int:
         from .state import field_nbytes
         return sum(field_nbytes(f) for f in (self.cell_count, self.cell_start, self.block_sum,
-                                             self.particle_cell, self.rank, self.order,
-                                             self.sorted_pos))
+                                             self.group_sum, self.particle_cell, self.rank,
+                                             self.order, self.sorted_pos))
 
     def build(self, min_side: float, reorder: bool = False) -> None:
         """Rebuild at the current positions; with ``reorder`` permute the particles into cell
@@ -73,24 +77,23 @@ class CellGrid:
     def _plan(self, min_side: float):
         d = ti.static(self.dim)
         pos, kind = ti.static(self.state.pos, self.state.kind)
-        # bounds of the live particles: per block, then over the blocks (no contended atomics)
-        for b in range((self.state.n[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+        # bounds of the live particles, by blocks (blocks.py: no contended atomics)
+        for b in range(blocks_for(self.state.n[None])):
             lo = ti.Vector([3.0e38] * d)
             hi = ti.Vector([-3.0e38] * d)
-            for i in range(b * SCAN_BLOCK, ti.min(self.state.n[None], (b + 1) * SCAN_BLOCK)):
+            for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
                 if kind[i] != GONE:
                     lo = ti.min(lo, pos[i])
                     hi = ti.max(hi, pos[i])
             self.block_lo[b] = lo
             self.block_hi[b] = hi
+        blocks = blocks_for(self.state.n[None])
+        reduce_blocks(self.block_lo, blocks, self.group_lo, self.live_lo, smaller, self._far_up)
+        reduce_blocks(self.block_hi, blocks, self.group_hi, self.live_hi, larger, self._far_down)
         for _ in range(1):   # serial: cell side and dimensions that fit in max_cells
             for k in ti.static(range(d)):
-                self.lo[k] = 3.0e38
-                self.hi[k] = -3.0e38
-            for b in range((self.state.n[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
-                for k in ti.static(range(d)):
-                    self.lo[k] = ti.min(self.lo[k], self.block_lo[b][k])
-                    self.hi[k] = ti.max(self.hi[k], self.block_hi[b][k])
+                self.lo[k] = self.live_lo[None][k]
+                self.hi[k] = self.live_hi[None][k]
             h = min_side
             if self.lo[0] > self.hi[0]:       # no live particle
                 for k in ti.static(range(d)):
@@ -125,24 +128,21 @@ class CellGrid:
                 self.rank[i] = ti.atomic_add(self.cell_count[c], 1)
             else:
                 self.particle_cell[i] = -1
-        # blocked exclusive prefix sum of cell_count into cell_start
-        for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+        # exclusive prefix sum of cell_count into cell_start: sums per block of cells, their
+        # scan (blocks.py), then the scan inside each block
+        cells = self.num_cells[None]
+        for b in range(blocks_for(cells)):
             s = 0
-            for c in range(b * SCAN_BLOCK, ti.min(self.num_cells[None], (b + 1) * SCAN_BLOCK)):
+            for c in range(b * BLOCK, ti.min(cells, (b + 1) * BLOCK)):
                 s += self.cell_count[c]
             self.block_sum[b] = s
+        exclusive_scan(self.block_sum, blocks_for(cells), self.group_sum, self.n_live)
         for _ in range(1):
-            run = 0
-            for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
-                s = self.block_sum[b]
-                self.block_sum[b] = run
-                run += s
-            self.n_live[None] = run
-            self.cell_start[self.num_cells[None]] = run
+            self.cell_start[cells] = self.n_live[None]
             self.n_parked[None] = 0
-        for b in range((self.num_cells[None] + SCAN_BLOCK - 1) // SCAN_BLOCK):
+        for b in range(blocks_for(cells)):
             run = self.block_sum[b]
-            for c in range(b * SCAN_BLOCK, ti.min(self.num_cells[None], (b + 1) * SCAN_BLOCK)):
+            for c in range(b * BLOCK, ti.min(cells, (b + 1) * BLOCK)):
                 self.cell_start[c] = run
                 run += self.cell_count[c]
         # scatter; parked particles go after the live ones so a permutation keeps them
@@ -162,6 +162,14 @@ class CellGrid:
     def _identity_order(self):
         for k in range(self.state.n[None]):
             self.order[k] = k
+
+    @ti.func
+    def _far_up(self):
+        return ti.Vector([3.0e38] * self.dim)
+
+    @ti.func
+    def _far_down(self):
+        return ti.Vector([-3.0e38] * self.dim)
 
     # ---- functions used by the passes ----------------------------------------------------
     @ti.func

@@ -9,13 +9,13 @@ from typing import Dict, List
 import numpy as np
 import taichi as ti
 
+from .blocks import BLOCK, blocks_for, groups_for, larger, reduce_blocks
 from .coefficients import Coefficients
 from .state import FLUID, GONE, ParticleState
 
 AXES = "xyz"
 F_SPEED2, F_EXCESS, F_KINETIC, F_POTENTIAL = range(4)
 I_NONFINITE = 0          # then one counter per exit reason
-BLOCK = 1024             # particles per block of the two-level reduction
 
 
 @ti.func
@@ -30,22 +30,24 @@ def finite(x) -> bool:
 
 
 @ti.func
+def zero():
+    return 0.0
+
+
+@ti.func
 def fluid_max(state: ti.template(), values: ti.template(), blocks: ti.template(),
-              out: ti.template()):
-    """out[None] = the largest values[i] >= 0 over the fluid particles: per block of particles,
-    then over the blocks (no contended atomics). Called at a kernel's top level."""
+              groups: ti.template(), out: ti.template()):
+    """out[None] = the largest values[i] >= 0 over the fluid particles, by blocks
+    (blocks.py): ``blocks`` holds blocks_for(capacity) entries, ``groups`` groups_for of that.
+    Called at a kernel's top level."""
     n = state.n[None]
-    for b in range((n + BLOCK - 1) // BLOCK):
+    for b in range(blocks_for(n)):
         top = 0.0
         for i in range(b * BLOCK, ti.min(n, (b + 1) * BLOCK)):
             if state.kind[i] == FLUID:
                 top = ti.max(top, values[i])
         blocks[b] = top
-    for _ in range(1):
-        top = 0.0
-        for b in range((n + BLOCK - 1) // BLOCK):
-            top = ti.max(top, blocks[b])
-        out[None] = top
+    reduce_blocks(blocks, blocks_for(n), groups, out, larger, zero)
 
 
 def exit_reasons(dim: int) -> List[str]:
@@ -90,10 +92,15 @@ class Health:
         self.reasons = exit_reasons(self.dim)
         self.fstats = ti.field(float, 4)
         self.istats = ti.field(ti.i32, 1 + len(self.reasons))
-        blocks = (state.capacity + BLOCK - 1) // BLOCK
+        blocks = blocks_for(state.capacity)
+        # per block: speed^2 and excess (largest), kinetic and potential energy (sums); and
+        # the counts of non-finite particles and of particles parked per exit reason
         self.block_stats = ti.Vector.field(4, float, blocks)
-        self.block_bad = ti.field(ti.i32, blocks)
-        self.block_left = ti.field(ti.i32, (blocks, 2 * self.dim))    # parked, per exit reason
+        self.block_counts = ti.Vector.field(1 + 2 * self.dim, ti.i32, blocks)
+        self.group_stats = ti.Vector.field(4, float, groups_for(blocks))
+        self.group_counts = ti.Vector.field(1 + 2 * self.dim, ti.i32, groups_for(blocks))
+        self.total_stats = ti.Vector.field(4, float, shape=())
+        self.total_counts = ti.Vector.field(1 + 2 * self.dim, ti.i32, shape=())
 
     def reset(self) -> None:
         self.istats.fill(0)
@@ -111,11 +118,11 @@ class Health:
 
     @ti.kernel
     def _reduce(self):
-        """Per block of particles, then over the blocks, with no atomic on a stat: on Taichi
-        1.7.4's Vulkan arch (lavapipe) an atomic add on the counters inside either loop spoiled
-        that whole loop's results (max speed 0 while the drop fell at 8 m/s; one block's exit
-        counts of three; tests/test_gpu_arch.py)."""
-        for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
+        """Per block of particles, then over the blocks (blocks.py), with no atomic on a stat:
+        on Taichi 1.7.4's Vulkan arch (lavapipe) an atomic add on the counters inside either
+        loop spoiled that whole loop's results (max speed 0 while the drop fell at 8 m/s; one
+        block's exit counts of three; tests/test_gpu_arch.py)."""
+        for b in range(blocks_for(self.state.n[None])):
             speed2, excess, kinetic, potential, bad_count = 0.0, 0.0, 0.0, 0.0, 0
             left = ti.Vector.zero(ti.i32, 2 * self.dim)
             m, n0 = self.coef.mass[None], self.coef.n0[None]
@@ -150,27 +157,40 @@ class Health:
                             kinetic += 0.5 * m * u2
                             potential -= m * g.dot(x)
             self.block_stats[b] = ti.Vector([speed2, excess, kinetic, potential])
-            self.block_bad[b] = bad_count
+            counts = ti.Vector.zero(ti.i32, 1 + 2 * self.dim)
+            counts[I_NONFINITE] = bad_count
             for k in ti.static(range(2 * self.dim)):
-                self.block_left[b, k] = left[k]
+                counts[1 + k] = left[k]
+            self.block_counts[b] = counts
+        blocks = blocks_for(self.state.n[None])
+        reduce_blocks(self.block_stats, blocks, self.group_stats, self.total_stats,
+                      self._combine_stats, self._no_stats)
+        reduce_blocks(self.block_counts, blocks, self.group_counts, self.total_counts,
+                      self._add_counts, self._no_counts)
         for _ in range(1):
-            total = ti.Vector([0.0, 0.0, 0.0, 0.0])
-            bad_total = 0
-            left = ti.Vector.zero(ti.i32, 2 * self.dim)
-            for b in range((self.state.n[None] + BLOCK - 1) // BLOCK):
-                v = self.block_stats[b]
-                total[F_SPEED2] = ti.max(total[F_SPEED2], v[F_SPEED2])
-                total[F_EXCESS] = ti.max(total[F_EXCESS], v[F_EXCESS])
-                total[F_KINETIC] += v[F_KINETIC]
-                total[F_POTENTIAL] += v[F_POTENTIAL]
-                bad_total += self.block_bad[b]
-                for k in ti.static(range(2 * self.dim)):
-                    left[k] += self.block_left[b, k]
+            total, counts = self.total_stats[None], self.total_counts[None]
             for k in ti.static(range(4)):
                 self.fstats[k] = total[k]
             for k in ti.static(range(2 * self.dim)):     # reason 1 + k, cumulative
-                self.istats[2 + k] = self.istats[2 + k] + left[k]
-            self.istats[I_NONFINITE] = bad_total
+                self.istats[2 + k] = self.istats[2 + k] + counts[1 + k]
+            self.istats[I_NONFINITE] = counts[I_NONFINITE]
+
+    @ti.func
+    def _combine_stats(self, a, b):
+        return ti.Vector([ti.max(a[F_SPEED2], b[F_SPEED2]), ti.max(a[F_EXCESS], b[F_EXCESS]),
+                          a[F_KINETIC] + b[F_KINETIC], a[F_POTENTIAL] + b[F_POTENTIAL]])
+
+    @ti.func
+    def _no_stats(self):
+        return ti.Vector([0.0, 0.0, 0.0, 0.0])
+
+    @ti.func
+    def _add_counts(self, a, b):
+        return a + b
+
+    @ti.func
+    def _no_counts(self):
+        return ti.Vector.zero(ti.i32, 1 + 2 * self.dim)
 
     def measure(self) -> HealthReport:
         self._reduce()

@@ -32,7 +32,8 @@ import taichi as ti
 
 from .coefficients import Coefficients
 from .grid import CellGrid
-from .health import BLOCK, fluid_max
+from .blocks import blocks_for, groups_for
+from .health import fluid_max
 from .operators import laplacian_pair, weight
 from .params import Model
 from .plane_floor import FLOOR_V, PlaneFloor
@@ -67,9 +68,11 @@ class Predictor:
         if self.lists_close_pairs:
             self.close_count = ti.field(ti.i32, self.state.capacity)
             self.close_index = ti.field(ti.i32, (self.state.capacity, CLOSE_SLOTS))
-        self.block_rel2 = self.rel2 = None       # only with the relative Courant limit
+        self.block_rel2 = self.group_rel2 = self.rel2 = None  # only with the relative Courant limit
         if self.measures_relative_speed:
-            self.block_rel2 = ti.field(float, (self.state.capacity + BLOCK - 1) // BLOCK)
+            blocks = blocks_for(self.state.capacity)
+            self.block_rel2 = ti.field(float, blocks)
+            self.group_rel2 = ti.field(float, groups_for(blocks))
             self.rel2 = ti.field(float, shape=())
 
     @property
@@ -91,7 +94,7 @@ class Predictor:
         if self.lists_close_pairs:
             fields += [self.close_count, self.close_index]
         if self.measures_relative_speed:
-            fields += [self.block_rel2, self.rel2]
+            fields += [self.block_rel2, self.group_rel2, self.rel2]
         return sum(field_nbytes(f) for f in fields)
 
     @property
@@ -192,7 +195,8 @@ class Predictor:
                         a += self.coef.gravity[None]
                     self.state.scratch_vec[i] = a
             if ti.static(self.measures_relative_speed):
-                fluid_max(self.state, self.state.scratch_float, self.block_rel2, self.rel2)
+                fluid_max(self.state, self.state.scratch_float, self.block_rel2, self.group_rel2,
+                          self.rel2)
 
     @ti.kernel
     def accelerate(self, dt: float):
