@@ -12,7 +12,7 @@ import math
 from typing import Dict, List
 
 from .core.params import Model
-from .core.step import Simulator
+from .core.step import Simulator, max_particles
 
 HEADROOM = 1.25         # capacity of a reallocated simulator, times the scene's particles
 
@@ -46,7 +46,8 @@ class Session:
         elif sim.state.capacity < n:
             old = sim.state.capacity
             self._sims.pop(model)
-            sim = self._build(scene, max(n, math.ceil(self.headroom * n)))
+            room = min(math.ceil(self.headroom * n), max_particles(model))
+            sim = self._build(scene, max(n, room))
             self.reallocations += 1
             self.events.append(f"reallocated: {n:,} particles exceed the capacity {old:,}; "
                                f"new capacity {sim.state.capacity:,}")

@@ -117,6 +117,7 @@ def _preset_facts(r, tp) -> Dict:
     from ..config import estimate
     from ..core.lattice import LatticeConstants
     from ..core.params import Model
+    from ..core.step import max_particles
     from ..scenes.crown import crown_base_radius
 
     ph, s, liq = r.physics, r.scene, r.liquid
@@ -157,6 +158,7 @@ def _preset_facts(r, tp) -> Dict:
                      if key not in ("dt_max", "approach") or key in lim},
         "dt_s": dt, "binding": est["binding"], "binding_ties": ties,
         "particles": est["particles"], "memory_bytes": est["memory_bytes"],
+        "max_particles": max_particles(r.model),
         "steps": est["steps"], "steps_at_U": est["steps_at_U"],
         "splash_speed_m_s": est["splash_speed_m_s"],
         "relative_speed_m_s": est["relative_speed_m_s"],
@@ -258,6 +260,10 @@ def _info_preset(args) -> int:
     print(f"  particles   {approx}{p['fluid']:,} fluid (film {p['n_film']:,}, drop "
           f"{p['n_drop']:,}), {approx}{p['wall']:,} wall, {approx}{p['dummy']:,} dummy "
           f"({approx}{p['total']:,} total{how})")
+    if p["total"] > f["max_particles"]:
+        need = r.l0 * (p["total"] / f["max_particles"]) ** (1.0 / r.dim)
+        print(f"  too many    one simulator holds at most {f['max_particles']:,} particles "
+              f"(Taichi's 32-bit field indices): a run would be refused; l0 >= ~{_mm(need)}")
     print(f"  memory      ~{estimate.human_bytes(f['memory_bytes'])} ({tp.bytes_per_particle:g} "
           f"bytes per particle with the cell grid, f32)")
     speeds = (f"the splash's ~{f['splash_speed_m_s']:.3g} m/s = {estimate.SPLASH_MACH:g} c")

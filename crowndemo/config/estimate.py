@@ -116,7 +116,7 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
     """Particles by kind: exact from the scene built at l0 when that is at most
     ``exact_up_to`` particles, else scaled from the scene built at a coarser spacing with
     about ``scale_from`` particles (fluid by film layers and drop volume, walls by area)."""
-    rough = _rough_total(r)
+    rough = rough_total(r)
     if rough <= exact_up_to:
         sc = r.build_scene()
         c = sc.counts()
@@ -147,7 +147,8 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
             "extent_m": sc.info.get("extent_m")}
 
 
-def _rough_total(r: Resolved) -> float:
+def rough_total(r: Resolved) -> float:
+    """Particles of the scene from its sizes alone (fluid volume and floor area over l0^d)."""
     from ..scenes.crown import reach_radius
     s, d, l0 = r.scene, r.dim, r.l0
     half = s["floor"] / 2

@@ -17,6 +17,9 @@ from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
 SPEED_MAX = 50.0        # m/s: beyond this the explicit step is not meant to serve
 DT_FLOOR = 1.0e-8       # s: a time step below this is refused (billions of steps)
 MIN_ACROSS = 3          # particles across the film and across the drop
+# estimate.rough_total is 0.84-1.03 of the scene's particle count (every preset at every
+# quality, 2026-11-23): past this many times the limit a scene is refused before it is built
+ROUGH_MARGIN = 1.1
 
 
 @dataclass
@@ -73,7 +76,33 @@ class Resolved:
         kw = self.crown_kwargs()
         if l0 is not None:
             kw["l0"] = l0
-        return crown(**kw)
+        if l0 is None:      # far too many particles: say so before numpy builds them
+            from .estimate import rough_total
+            rough = rough_total(self)
+            if rough > ROUGH_MARGIN * self.max_particles():
+                self.check_size(int(rough), about=True)
+        scene = crown(**kw)
+        if l0 is None:
+            self.check_size(len(scene.pos))
+        return scene
+
+    def max_particles(self) -> int:
+        from ..core.step import max_particles
+        return max_particles(self.model)
+
+    def check_size(self, particles: int, about: bool = False) -> None:
+        """PresetError on the l0 key when the scene has more particles than one simulator
+        holds (``core.step.max_particles``: Taichi's 32-bit field indices), before any kernel
+        runs."""
+        limit = self.max_particles()
+        if particles > limit:
+            key, source = self.where["l0"]
+            need = self.l0 * (particles / limit) ** (1.0 / self.dim)
+            raise PresetError(source, key, self.l0,
+                              f"the scene would hold {'about ' if about else ''}{particles:,} "
+                              f"particles, more than the {limit:,} that one simulator holds "
+                              f"in {self.dim}D (Taichi indexes a field with 32-bit integers)",
+                              f">= {'about ' if about else ''}{need * 1.001:.4g} m")
 
     def frame_times(self) -> List[float]:
         """Frame times strictly inside (0, t_end], every frame_interval; [] without one."""

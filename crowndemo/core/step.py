@@ -17,12 +17,13 @@ from .coefficients import Coefficients
 from .grid import CellGrid
 from .health import Health, HealthReport, InstabilityError, count_kinds
 from .lattice import LatticeConstants, wall_layers
+from .neighbours import SLOTS
 from .operators import Operators
-from .params import Model, Numerics, Physics
+from .params import Model, Numerics, ParameterError, Physics
 from .plane_floor import PlaneFloor
 from .pressure import Pressure
 from .state import FLUID, ParticleState
-from .terms import Predictor
+from .terms import CLOSE_SLOTS, Predictor
 
 
 # codes of RunStats.bound_log; the order of older checkpoints' codes kept
@@ -92,6 +93,29 @@ def default_max_cells(particles: int) -> int:
     return max(CELLS_PER_PARTICLE * particles, 4096)
 
 
+# Taichi 1.7.4 indexes a field's entries with 32-bit integers: a field of 2^31 entries or more
+# crashed it (a segmentation fault at the first kernel, 2026-11-23), so none may have more
+FIELD_ENTRIES_MAX = 2 ** 31 - 1
+
+
+def entries_per_particle(model: Model) -> int:
+    """The most entries per particle of capacity held by one field of a simulator for
+    ``model``: the cell grid's cells (CELLS_PER_PARTICLE), the neighbour list's slots, the
+    close-pair list's slots."""
+    m = CELLS_PER_PARTICLE
+    if model.neighbour_list:
+        m = max(m, SLOTS[model.dim])
+    if model.collision:
+        m = max(m, CLOSE_SLOTS)
+    return m
+
+
+def max_particles(model: Model) -> int:
+    """The most particles one simulator for ``model`` holds: every field below
+    FIELD_ENTRIES_MAX entries (38.3 M in 3D with the neighbour list, whose 56 slots bind)."""
+    return (FIELD_ENTRIES_MAX - 1) // entries_per_particle(model)
+
+
 class Simulator:
     """Holds one compiled step. ``configure`` changes run-time values without recompiling;
     the compiled terms (``Model``) are fixed at construction. Room for at least ``capacity``
@@ -103,7 +127,18 @@ class Simulator:
         numerics.validate()
         self.model = Model.of(physics, numerics)
         dim = physics.dim
-        capacity = capacity_bucket(capacity)
+        limit = max_particles(self.model)
+        if capacity > limit:
+            raise ParameterError(
+                "particles", capacity,
+                f"at most {limit:,} for this model in {dim}D (Taichi indexes a field with "
+                f"32-bit integers and the largest field holds "
+                f"{entries_per_particle(self.model)} entries per particle); a coarser l0",
+                source="simulator")
+        if max_cells is not None and not 1 <= max_cells < FIELD_ENTRIES_MAX:
+            raise ParameterError("max_cells", max_cells, f"1 to {FIELD_ENTRIES_MAX - 1:,}",
+                                 source="simulator")
+        capacity = min(capacity_bucket(capacity), limit)
         self.state = ParticleState(dim, capacity)
         self._auto_cells = max_cells is None    # then the cell limit follows the particles
         self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity),
