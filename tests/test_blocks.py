@@ -1,4 +1,5 @@
-"""The block reductions and prefix sums (core/blocks.py) against numpy. Applied here straight
+"""The block reductions and prefix sums (core/blocks.py) against numpy, on the CPU and on each
+GPU arch that Taichi finds. Applied here straight
 to an array, the helpers cut it into groups of BLOCK entries: the sizes fill none, one and
 several groups, the last one part full, so the parallel stage and the serial stage above it
 both count."""
@@ -6,6 +7,8 @@ import numpy as np
 import pytest
 import taichi as ti
 
+from crowndemo import backend
+from crowndemo.backend import BackendError
 from crowndemo.core.blocks import (BLOCK, add, blocks_for, exclusive_scan, groups_for, larger,
                                    reduce_blocks, smaller)
 
@@ -50,6 +53,30 @@ class _Bench:
         exclusive_scan(self.ints, count, self.int_groups, self.int_out)
 
 
+def outcomes(bench: _Bench, count: int) -> list:
+    """(what, got, want) for each helper on ``count`` random entries."""
+    rng = np.random.default_rng(count)
+    ints = rng.integers(0, 1000, LARGEST).astype(np.int32)
+    vecs = rng.uniform(-5.0, 5.0, (LARGEST, 2)).astype(np.float32)
+    bench.ints.from_numpy(ints)
+    bench.vecs.from_numpy(vecs)
+    out = []
+    bench.int_sum(count)
+    out.append(("sum", bench.int_out[None], int(ints[:count].sum())))
+    bench.int_max(count)
+    out.append(("max", bench.int_out[None], int(ints[:count].max()) if count else 0))
+    bench.vec_min(count)
+    want = vecs[:count].min(axis=0) if count else np.full(2, 3.0e38, np.float32)
+    out.append(("min", bench.vec_out[None].to_numpy().tolist(), want.tolist()))
+    bench.scan(count)
+    got = bench.ints.to_numpy()
+    want = np.concatenate([[0], np.cumsum(ints[:count], dtype=np.int64)[:-1]]) if count else []
+    out.append(("scan", got[:count].tolist(), list(want)))
+    out.append(("past count, untouched", got[count:].tolist(), ints[count:].tolist()))
+    out.append(("scan total", bench.int_out[None], int(ints[:count].sum())))
+    return out
+
+
 @pytest.fixture(scope="module")
 def bench():
     return _Bench()
@@ -61,29 +88,28 @@ def test_blocks_for_counts_partial_blocks():
 
 
 @pytest.mark.parametrize("count", SIZES)
-def test_reductions_match_numpy(bench, count):
-    rng = np.random.default_rng(count)
-    ints = rng.integers(0, 1000, LARGEST).astype(np.int32)
-    vecs = rng.uniform(-5.0, 5.0, (LARGEST, 2)).astype(np.float32)
-    bench.ints.from_numpy(ints)
-    bench.vecs.from_numpy(vecs)
-    bench.int_sum(count)
-    assert bench.int_out[None] == int(ints[:count].sum())
-    bench.int_max(count)
-    assert bench.int_out[None] == (int(ints[:count].max()) if count else 0)
-    bench.vec_min(count)
-    want = vecs[:count].min(axis=0) if count else np.full(2, 3.0e38, np.float32)
-    assert np.array_equal(bench.vec_out[None].to_numpy(), want)
+def test_reductions_and_scan_match_numpy(bench, count):
+    for what, got, want in outcomes(bench, count):
+        assert got == want, what
 
 
-@pytest.mark.parametrize("count", SIZES)
-def test_exclusive_scan_matches_numpy(bench, count):
-    rng = np.random.default_rng(count + 1)
-    ints = rng.integers(0, 9, LARGEST).astype(np.int32)
-    bench.ints.from_numpy(ints)
-    bench.scan(count)
-    got = bench.ints.to_numpy()
-    want = np.concatenate([[0], np.cumsum(ints[:count], dtype=np.int64)[:-1]]) if count else []
-    assert np.array_equal(got[:count], want)
-    assert np.array_equal(got[count:], ints[count:])      # entries past count untouched
-    assert bench.int_out[None] == int(ints[:count].sum())
+GPU_ARCHS = ("vulkan", "cuda")
+
+
+@pytest.mark.parametrize("arch", GPU_ARCHS)
+def test_reductions_and_scan_on_the_gpu_arch(arch):
+    """The same on each GPU arch that Taichi finds (lavapipe's Vulkan on a machine without a
+    GPU; tests/test_gpu_arch.py): there every stage is a device task and the serial one runs
+    on one GPU thread."""
+    try:
+        backend.init(arch)
+    except BackendError as e:
+        backend.init("cpu")
+        pytest.skip(f"no {arch} device for Taichi: {e}")
+    try:
+        bench = _Bench()
+        wrong = [(count, what) for count in SIZES
+                 for what, got, want in outcomes(bench, count) if got != want]
+    finally:
+        backend.init("cpu")          # the session's backend (resets Taichi)
+    assert wrong == []
