@@ -1,8 +1,7 @@
 """The block reductions and prefix sums (core/blocks.py) against numpy, on the CPU and on each
-GPU arch that Taichi finds. Applied here straight
-to an array, the helpers cut it into groups of BLOCK entries: the sizes fill none, one and
-several groups, the last one part full, so the parallel stage and the serial stage above it
-both count."""
+GPU arch that Taichi finds. Applied here straight to an array, the helpers cut it into groups
+of BLOCK entries: the sizes fill none, one and several groups, the last one part full, so the
+parallel stage and the serial stage above it both count."""
 import numpy as np
 import pytest
 import taichi as ti
