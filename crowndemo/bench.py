@@ -70,15 +70,15 @@ def run_one(n: int, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
 
     from . import backend
     from .core import simulator_for
-    from .core.params import with_values
+    from .core.params import Numerics, with_values
     from .scenes import hydrostatic_tank
 
     be = backend.current()
     k, kz = block_shape(n)
     t0 = time.perf_counter()
-    scene = hydrostatic_tank(dim=3, l0=l0, width=k * l0, depth=kz * l0, re_ratio=2.1)
-    if numerics:
-        scene.numerics = with_values(scene.numerics, **numerics)
+    # the numerics go to the builder: the floor is built of particles or not (wall_model)
+    scene = hydrostatic_tank(dim=3, l0=l0, width=k * l0, depth=kz * l0, re_ratio=2.1,
+                             numerics=with_values(Numerics(), **(numerics or {})))
     sim = simulator_for(scene)
     ti.sync()
     setup_s = time.perf_counter() - t0
@@ -221,10 +221,18 @@ class _Enough(Exception):
 
 
 def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = DEFAULT_L0,
-        on_result=None, compare: bool = False, stages: bool = True) -> List[Dict]:
+        on_result=None, compare: bool = False, stages: bool = True,
+        numerics: Optional[Dict] = None) -> List[Dict]:
     """One result per N; with ``compare``, the seed's formulation (SEED_NUMERICS) first and
-    then the tuned one, for each N, in this process."""
-    variants = [("seed", SEED_NUMERICS), ("tuned", None)] if compare else [("tuned", None)]
+    then the tuned one, for each N, in this process; with ``numerics``, those overrides
+    (labelled ``KEY=VALUE, ...``) instead of the project's numerics."""
+    if numerics:
+        label = ", ".join(f"{k}={v}" for k, v in numerics.items())
+        variants = [(label, dict(numerics))]
+    elif compare:
+        variants = [("seed", SEED_NUMERICS), ("tuned", None)]
+    else:
+        variants = [("tuned", None)]
     results = []
     for n in ns:
         for label, numerics in variants:

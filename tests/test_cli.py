@@ -51,6 +51,8 @@ def test_info_table(capsys):
     (["scene", "tank", "--a", "0.1"], "--a"),
     (["bench", "--n", "0"], "n"),
     (["bench", "--set", "scene.speed=3"], "--preset"),
+    (["bench", "--set", "numerics.cells_per_re=7"], "numerics.cells_per_re"),
+    (["bench", "--set", "numerics.courant=0.3", "--compare"], "--compare"),
     (["bench", "--preset", "quick", "--n", "1000"], "--preset"),
     (["bench", "--preset", "nosuch-preset"], "nosuch-preset"),
     (["bench", "--preset", "quick", "--set", "scene.speed=-1"], "scene.speed"),
@@ -84,6 +86,27 @@ def test_bench_json(capsys):
     assert data["compile_s"] >= 0
     assert data["bytes_per_particle"] > 0
     assert data["precision"] == "f32"
+
+
+def test_bench_tank_with_numerics_overrides(capsys):
+    """--set numerics.KEY=VALUE on the tank block: compiled with those numerics, labelled with
+    them, and the scene built for them (the analytic plane floor replaces the floor's
+    particle layers)."""
+    from crowndemo.bench import block_shape
+    from crowndemo.core import Numerics
+    from crowndemo.scenes import hydrostatic_tank
+    assert main(["bench", "--n", "2000", "--steps", "1", "--no-stages", "--json",
+                 "--fast-compile", "--set", "numerics.wall_model=plane",
+                 "--set", "numerics.neighbour_list=false"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["label"] == "wall_model=plane, neighbour_list=False"
+    assert data["model"]["plane_floor"] and not data["model"]["neighbour_list"]
+    k, kz = block_shape(2000)
+    plane = hydrostatic_tank(dim=3, l0=1e-3, width=k * 1e-3, depth=kz * 1e-3, re_ratio=2.1,
+                             numerics=Numerics(wall_model="plane"))
+    assert data["particles"]["total"] == len(plane.pos)
+    assert len(plane.pos) < len(hydrostatic_tank(dim=3, l0=1e-3, width=k * 1e-3,
+                                                 depth=kz * 1e-3, re_ratio=2.1).pos)
 
 
 def test_bench_preset_json(capsys):

@@ -5,7 +5,7 @@ import json
 import os
 import shlex
 import sys
-from typing import Sequence
+from typing import Dict, Sequence
 
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
@@ -20,6 +20,7 @@ examples:
   crowndemo bench --arch cuda --n 1000000     # on an NVIDIA GPU
   crowndemo bench --record                    # append the results to BENCHMARKS.md
   crowndemo bench --compare --n 100000        # the seed's formulation against the tuned one
+  crowndemo bench --n 300000 --set numerics.cells_per_re=1   # one numerics value changed
   crowndemo bench --preset 3m-drop            # the 3m-drop preset at booth quality to its end
   crowndemo bench --preset 2.5m-drop --quality seed --arch cuda --record   # on a GPU
 
@@ -34,7 +35,8 @@ the particles in use, walls included.
 --compare runs each N twice in one process: "seed" is the seed's formulation with a plain
 implementation (gradient P_j - P_i, no collision model, cells of side re, no neighbour list, no
 re-sort); "tuned" is the project's default (pmin gradient, collisions, cells of side re/2, the
-neighbour list, re-sort every step). It prints tuned / seed.
+neighbour list, re-sort every step). It prints tuned / seed. --set numerics.KEY=VALUE (any
+number of times) runs the block with those numerics instead, labelled with them.
 
 --preset runs presets to their end time instead (as `crowndemo run`, nothing recorded), at
 --quality (default booth) with --set overrides: "to t_end s" is the whole wall time (scene
@@ -51,9 +53,13 @@ def _bench(args, argv: Sequence[str]) -> int:
 
     if args.preset:
         return _bench_presets(args, argv)
-    if args.sets or args.quality or args.max_steps is not None:
-        raise ParameterError("--set/--quality/--max-steps", "given",
+    if args.quality or args.max_steps is not None:
+        raise ParameterError("--quality/--max-steps", "given",
                              "only with --preset (the tank block has none)", "command line")
+    numerics = _tank_numerics(args.sets)
+    if numerics and args.compare:
+        raise ParameterError("--set/--compare", "given", "one or the other (--compare sets "
+                             "the numerics of its two variants)", "command line")
     ns = args.n or list(bench.DEFAULT_NS)
     for n in ns:
         if n < 1:
@@ -69,9 +75,33 @@ def _bench(args, argv: Sequence[str]) -> int:
                   f"particle-steps/s", file=sys.stderr, flush=True)
 
     results = bench.run(ns, args.steps, on_result=progress, compare=args.compare,
-                        stages=not args.no_stages)
+                        stages=not args.no_stages, numerics=numerics)
     _finish(args, argv, results)
     return 0
+
+
+def _tank_numerics(items: Sequence[str]) -> Dict:
+    """``--set numerics.KEY=VALUE`` for the tank block: values of the core's Numerics (the
+    tank has no other keys), checked by ``Numerics.validate`` before any kernel runs."""
+    from ..config import PresetError, overrides
+    from ..core.params import Numerics, with_values
+
+    values: Dict = {}
+    known = sorted(Numerics.__dataclass_fields__)
+    for item in items:
+        parts, value = overrides.parse(item)
+        if len(parts) != 2 or parts[0] != "numerics" or parts[1] not in known:
+            raise PresetError(overrides.SOURCE, ".".join(parts), value,
+                              "not a numerics key: the tank block takes numerics.KEY only "
+                              "(a preset's other keys need --preset)",
+                              "numerics." + ", numerics.".join(known))
+        values[parts[1]] = value
+    try:
+        with_values(Numerics(), **values).validate()
+    except ParameterError as e:
+        raise PresetError(overrides.SOURCE, "numerics." + e.key, e.value, "out of range",
+                          e.allowed) from None
+    return values
 
 
 def _finish(args, argv: Sequence[str], results) -> None:
@@ -139,7 +169,8 @@ def register(sub, common) -> None:
     p.add_argument("--quality", choices=QUALITIES,
                    help="quality rung of --preset (default: booth)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a value of --preset (as in crowndemo run)")
+                   help="override a value of --preset (as in crowndemo run); for the tank "
+                        "block, a numerics value (numerics.KEY=VALUE)")
     p.add_argument("--max-steps", type=int, metavar="N",
                    help="stop each --preset run after N steps (a smoke test)")
     p.add_argument("--record", action="store_true",
