@@ -2,6 +2,8 @@
 more crashed it (core/step.py, FIELD_ENTRIES_MAX). A simulator refuses a capacity that would
 need one, and a preset whose scene would be that large is refused on its l0 key, both before
 any kernel runs."""
+import json
+
 import numpy as np
 import pytest
 import taichi as ti
@@ -71,3 +73,14 @@ def test_preset_far_too_fine_is_refused_before_its_scene_is_built():
     with pytest.raises(PresetError, match=r"about [\d,]+ particles") as e:
         r.build_scene()
     assert e.value.key == "quality.seed.l0"
+
+
+def test_info_says_when_a_preset_is_too_large(capsys):
+    from crowndemo.cli import main
+    assert main(["info", "thick-layer", "--quality", "seed", "--set",
+                 "quality.seed.l0=8e-5"]) == 0
+    out = capsys.readouterr().out
+    assert "too many" in out and "a run would be refused" in out
+    assert main(["info", "thick-layer", "--quality", "seed", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["particles"]["total"] < d["max_particles"]          # the seed quality fits
