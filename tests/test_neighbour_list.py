@@ -3,13 +3,13 @@ dam break, the pressure-gradient accelerations (S18) computed from the list, by 
 (no list) and by a list too short for most particles (they fall back to the walk) agree to
 float rounding: a missed or doubled neighbour would change a particle's sum by ~1/30. The
 compiler may fuse the list's and the walk's arithmetic differently, so equality is to f32
-rounding, not to the bit.
+rounding, not to the bit. The list's slot-major memory layout holds the same lists.
 """
 import numpy as np
 import pytest
 
 from crowndemo import backend
-from crowndemo.core import FLUID, neighbours, simulator_for
+from crowndemo.core import FLUID, ParameterError, neighbours, simulator_for
 from crowndemo.core.params import with_values
 from crowndemo.scenes import dam_break
 
@@ -39,6 +39,17 @@ def accelerations(sim) -> np.ndarray:
     return sim.state.scratch_vec.to_numpy()[: sim.state.count][kind == FLUID]
 
 
+def in_use(sim) -> np.ndarray:
+    """Each fluid particle's listed neighbours in storage order, -1 past its count (slots
+    past the count hold what earlier steps left)."""
+    lst = sim.pressure.neighbours
+    n = sim.state.count
+    index, count = lst.index.to_numpy()[:n], lst.count.to_numpy()[:n]
+    kind = sim.state.kind.to_numpy()[:n]
+    used = np.arange(index.shape[1])[None, :] < count[:, None]
+    return np.where(used, index, -1)[kind == FLUID]
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_list_walk_and_fallback_give_the_same_gradient(single_thread, monkeypatch, dim):
     listed = simulator_for(scene(dim, True))
@@ -60,6 +71,19 @@ def test_list_walk_and_fallback_give_the_same_gradient(single_thread, monkeypatc
         return sim
 
     a_walk = accelerations(from_saved(False))
+    # the slot-major layout ($CROWNDEMO_LIST_LAYOUT, for GPUs): the same lists, slot by slot
+    monkeypatch.setenv(neighbours.LAYOUT_VARIABLE, "slot")
+    slot = from_saved(True)
+    a_slot = accelerations(slot)
+    assert slot.pressure.neighbours.layout == "slot"
+    n_slots = neighbours.SLOTS[dim]
+    assert slot.pressure.neighbours.index.shape == (listed.state.capacity, n_slots)
+    # stored slot-major: the outer level of the field's layout runs over the slots
+    assert slot.pressure.neighbours.index.snode.parent(2).shape == (n_slots,)
+    assert listed.pressure.neighbours.index.snode.parent(2).shape == (listed.state.capacity,)
+    for_slot, for_listed = in_use(slot), in_use(listed)
+    assert np.array_equal(for_slot, for_listed) and (for_slot >= 0).sum() > 10 * len(counts)
+    monkeypatch.delenv(neighbours.LAYOUT_VARIABLE)
     monkeypatch.setitem(neighbours.SLOTS, dim, 4)   # most particles overflow: cell walk
     short = from_saved(True)
     a_short = accelerations(short)
@@ -70,3 +94,10 @@ def test_list_walk_and_fallback_give_the_same_gradient(single_thread, monkeypatc
     tol = 1e-5 * scale
     assert np.abs(a_list - a_walk).max() < tol
     assert np.abs(a_short - a_walk).max() < tol
+    assert np.abs(a_slot - a_list).max() < tol
+
+
+def test_a_bad_list_layout_is_refused(monkeypatch):
+    monkeypatch.setenv(neighbours.LAYOUT_VARIABLE, "diagonal")
+    with pytest.raises(ParameterError, match=neighbours.LAYOUT_VARIABLE):
+        neighbours.layout_from_environment()

@@ -4,8 +4,12 @@ method.md S17-S18), so the second pass visits ~30 pairs instead of the ~145 cand
 5^3 cells around (BENCHMARKS.md). A particle with more neighbours than the list holds is
 marked by its count and walks the cells again: the list never drops a pair."""
 
+import os
+from typing import Optional
+
 import taichi as ti
 
+from .params import ParameterError
 from .state import ParticleState
 
 # entries per particle: a cubic lattice has 12 (2D) / 32 (3D) neighbours within re = 2.1 l0;
@@ -14,12 +18,34 @@ from .state import ParticleState
 SLOTS = {2: 24, 3: 56}
 
 
+# memory order of the list, index[i, m] either way: "particle" keeps a particle's slots together
+# (a CPU thread reads its own row); "slot" keeps slot m of consecutive particles together, so
+# the threads of a GPU warp read one contiguous line per slot. Not yet measured on a GPU
+# (BENCHMARKS.md, "GPU figures"): the default is "particle"; $CROWNDEMO_LIST_LAYOUT selects.
+LAYOUTS = ("particle", "slot")
+LAYOUT_VARIABLE = "CROWNDEMO_LIST_LAYOUT"
+
+
+def layout_from_environment() -> str:
+    layout = os.environ.get(LAYOUT_VARIABLE, "") or "particle"
+    if layout not in LAYOUTS:
+        raise ParameterError(LAYOUT_VARIABLE, layout, ", ".join(LAYOUTS), source="environment")
+    return layout
+
+
 @ti.data_oriented
 class NeighbourList:
-    def __init__(self, state: ParticleState):
+    def __init__(self, state: ParticleState, layout: Optional[str] = None):
         self.slots = SLOTS[state.dim]
+        self.layout = layout or layout_from_environment()
+        if self.layout not in LAYOUTS:
+            raise ParameterError("layout", self.layout, ", ".join(LAYOUTS), source="NeighbourList")
         self.count = ti.field(ti.i32, state.capacity)
-        self.index = ti.field(ti.i32, (state.capacity, self.slots))
+        self.index = ti.field(ti.i32)           # [particle, slot] in either layout
+        if self.layout == "slot":
+            ti.root.dense(ti.j, self.slots).dense(ti.i, state.capacity).place(self.index)
+        else:
+            ti.root.dense(ti.i, state.capacity).dense(ti.j, self.slots).place(self.index)
 
     def nbytes(self) -> int:
         from .state import field_nbytes
@@ -37,4 +63,4 @@ class NeighbourList:
         return self.count[i] <= ti.static(self.slots)
 
 
-__all__ = ["NeighbourList", "SLOTS"]
+__all__ = ["NeighbourList", "SLOTS", "LAYOUTS", "layout_from_environment"]
