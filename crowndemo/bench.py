@@ -135,6 +135,8 @@ def _backend_and_memory(be, sim) -> Dict:
     total = sim.state.count
     return {"arch": be.arch, "resolved_arch": be.resolved, "precision": be.precision,
             "single_thread": be.single_thread, "fast_compile": be.fast_compile,
+            "list_layout": (sim.pressure.neighbours.layout if sim.pressure.neighbours is not None
+                            else None),
             "bytes_per_particle": sim.memory_bytes() / total, "memory_bytes": sim.memory_bytes()}
 
 
@@ -261,9 +263,11 @@ def _preset_row(r: Dict) -> List[str]:
 
 
 def _build(r: Dict) -> str:
-    """The precision column: the float type, and how the kernels were run and built."""
+    """The precision column: the float type, and how the kernels were run and built (and the
+    neighbour list's layout where it is not the default)."""
     return (r["precision"] + (" 1-thread" if r["single_thread"] else "")
-            + (" fast-compile" if r.get("fast_compile") else ""))
+            + (" fast-compile" if r.get("fast_compile") else "")
+            + (" slot-list" if r.get("list_layout") == "slot" else ""))
 
 
 def _presets(results: Sequence[Dict]) -> bool:

@@ -47,5 +47,10 @@ def test_the_bench_says_how_it_compiled(capsys, monkeypatch):
         assert main(["bench", "--n", "500", "--steps", "1", "--fast-compile",
                      "--no-stages"]) == 0
         assert "f32 fast-compile" in capsys.readouterr().out
+        # and where the neighbour list is not stored as by default
+        monkeypatch.setenv("CROWNDEMO_LIST_LAYOUT", "slot")
+        assert main(["bench", "--n", "500", "--steps", "1", "--fast-compile",
+                     "--no-stages"]) == 0
+        assert "f32 fast-compile slot-list" in capsys.readouterr().out
     finally:
         backend.init("cpu")
