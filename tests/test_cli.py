@@ -86,6 +86,7 @@ def test_bench_json(capsys):
     assert data["compile_s"] >= 0
     assert data["bytes_per_particle"] > 0
     assert data["precision"] == "f32"
+    assert data["list_layout"] == "particle"          # the default storage of the list
 
 
 def test_bench_tank_with_numerics_overrides(capsys):
