@@ -78,9 +78,12 @@ def test_list_walk_and_fallback_give_the_same_gradient(single_thread, monkeypatc
     assert slot.pressure.neighbours.layout == "slot"
     n_slots = neighbours.SLOTS[dim]
     assert slot.pressure.neighbours.index.shape == (listed.state.capacity, n_slots)
-    # stored slot-major: the outer level of the field's layout runs over the slots
+    # stored slot-major: the outer level of the field's layout runs over the slots; the
+    # default is one row-major block, a particle's slots together
     assert slot.pressure.neighbours.index.snode.parent(2).shape == (n_slots,)
-    assert listed.pressure.neighbours.index.snode.parent(2).shape == (listed.state.capacity,)
+    default = listed.pressure.neighbours.index.snode
+    assert default.parent().shape == (listed.state.capacity, n_slots)
+    assert default.parent(2).shape == ()            # the root: one block, no outer level
     for_slot, for_listed = in_use(slot), in_use(listed)
     assert np.array_equal(for_slot, for_listed) and (for_slot >= 0).sum() > 10 * len(counts)
     monkeypatch.delenv(neighbours.LAYOUT_VARIABLE)

@@ -44,8 +44,8 @@ class NeighbourList:
         self.index = ti.field(ti.i32)           # [particle, slot] in either layout
         if self.layout == "slot":
             ti.root.dense(ti.j, self.slots).dense(ti.i, state.capacity).place(self.index)
-        else:
-            ti.root.dense(ti.i, state.capacity).dense(ti.j, self.slots).place(self.index)
+        else:       # as ti.field(ti.i32, (capacity, slots)): one row-major block
+            ti.root.dense(ti.ij, (state.capacity, self.slots)).place(self.index)
 
     def nbytes(self) -> int:
         from .state import field_nbytes
