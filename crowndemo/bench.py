@@ -237,8 +237,8 @@ def run(ns: Sequence[int] = DEFAULT_NS, steps: int = DEFAULT_STEPS, l0: float = 
         variants = [("tuned", None)]
     results = []
     for n in ns:
-        for label, numerics in variants:
-            r = run_one(n, steps, l0, numerics=numerics, label=label, stages=stages)
+        for label, overrides in variants:
+            r = run_one(n, steps, l0, numerics=overrides, label=label, stages=stages)
             results.append(r)
             if on_result:
                 on_result(r)

@@ -9,7 +9,7 @@ from typing import Dict, List
 import numpy as np
 import taichi as ti
 
-from .blocks import BLOCK, blocks_for, groups_for, larger, reduce_blocks
+from .blocks import BLOCK, add, blocks_for, groups_for, larger, reduce_blocks
 from .coefficients import Coefficients
 from .state import FLUID, GONE, ParticleState
 
@@ -123,8 +123,8 @@ class Health:
         loop spoiled that whole loop's results (max speed 0 while the drop fell at 8 m/s; one
         block's exit counts of three; tests/test_gpu_arch.py)."""
         for b in range(blocks_for(self.state.n[None])):
-            speed2, excess, kinetic, potential, bad_count = 0.0, 0.0, 0.0, 0.0, 0
-            left = ti.Vector.zero(ti.i32, 2 * self.dim)
+            speed2, excess, kinetic, potential = 0.0, 0.0, 0.0, 0.0
+            counts = self._no_counts()     # non-finite, then parked per exit reason 1..2d
             m, n0 = self.coef.mass[None], self.coef.n0[None]
             g = self.coef.gravity[None]
             for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
@@ -135,7 +135,7 @@ class Health:
                         if not (finite(x[k]) and finite(u[k])):
                             bad = True
                     if bad:
-                        bad_count += 1
+                        counts[I_NONFINITE] += 1
                     else:
                         reason = 0
                         for k in ti.static(range(self.dim)):
@@ -147,9 +147,9 @@ class Health:
                             self.state.kind[i] = GONE
                             self.state.exit_reason[i] = reason
                             self.state.vel[i] = ti.Vector.zero(float, self.dim)
-                            for k in ti.static(range(2 * self.dim)):
-                                if reason == 1 + k:
-                                    left[k] += 1
+                            for k in ti.static(range(1, 1 + 2 * self.dim)):
+                                if reason == k:
+                                    counts[k] += 1
                         else:
                             u2 = u.dot(u)
                             speed2 = ti.max(speed2, u2)
@@ -157,16 +157,12 @@ class Health:
                             kinetic += 0.5 * m * u2
                             potential -= m * g.dot(x)
             self.block_stats[b] = ti.Vector([speed2, excess, kinetic, potential])
-            counts = ti.Vector.zero(ti.i32, 1 + 2 * self.dim)
-            counts[I_NONFINITE] = bad_count
-            for k in ti.static(range(2 * self.dim)):
-                counts[1 + k] = left[k]
             self.block_counts[b] = counts
         blocks = blocks_for(self.state.n[None])
         reduce_blocks(self.block_stats, blocks, self.group_stats, self.total_stats,
                       self._combine_stats, self._no_stats)
         reduce_blocks(self.block_counts, blocks, self.group_counts, self.total_counts,
-                      self._add_counts, self._no_counts)
+                      add, self._no_counts)
         for _ in range(1):
             total, counts = self.total_stats[None], self.total_counts[None]
             for k in ti.static(range(4)):
@@ -183,10 +179,6 @@ class Health:
     @ti.func
     def _no_stats(self):
         return ti.Vector([0.0, 0.0, 0.0, 0.0])
-
-    @ti.func
-    def _add_counts(self, a, b):
-        return a + b
 
     @ti.func
     def _no_counts(self):

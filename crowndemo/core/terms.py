@@ -30,9 +30,9 @@ from typing import Callable, Optional
 
 import taichi as ti
 
+from .blocks import blocks_for, groups_for
 from .coefficients import Coefficients
 from .grid import CellGrid
-from .blocks import blocks_for, groups_for
 from .health import fluid_max
 from .operators import laplacian_pair, weight
 from .params import Model
