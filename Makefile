@@ -5,7 +5,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.crowndemo-installed
 
-.PHONY: setup vulkan demo test validate bench clean
+.PHONY: setup vulkan demo test validate bench device-wheels clean
 
 setup: $(STAMP) vulkan
 
@@ -43,6 +43,14 @@ validate: setup
 
 bench: setup
 	$(VENV)/bin/crowndemo bench
+
+# Taichi and dill as wheels for a lent GPU machine, which has Python 3.12 and the rest of what
+# crowndemo needs but not these: tools/device-measure.sh installs them from .whl/ there.
+device-wheels:
+	mkdir -p .whl
+	$(PYTHON) -m pip download --quiet --no-deps --only-binary=:all: --python-version 3.12 \
+	  --implementation cp --platform manylinux_2_27_x86_64 --platform manylinux2014_x86_64 \
+	  -d .whl taichi==1.7.4 dill
 
 clean:
 	rm -rf $(VENV) .pytest_cache

@@ -57,3 +57,15 @@ def test_the_bench_says_where_the_neighbour_list_is_not_stored_as_by_default():
     assert _build({**run, "list_layout": "particle"}) == "f32"
     assert _build({**run, "list_layout": None}) == "f32"          # no list
     assert _build({**run, "list_layout": "slot"}) == "f32 slot-list"
+
+
+def test_a_recorded_slot_list_run_names_the_variable_that_repeats_it():
+    from crowndemo.cli.bench import recorded_command
+    argv = ["bench", "--n", "12000000", "--record"]
+    assert recorded_command(argv, [{"list_layout": "particle"}]) == \
+        "crowndemo bench --n 12000000 --record"
+    assert recorded_command(argv, [{"list_layout": None}]) == \
+        "crowndemo bench --n 12000000 --record"
+    assert recorded_command(argv, [{"list_layout": "slot"}]) == \
+        "CROWNDEMO_LIST_LAYOUT=slot crowndemo bench --n 12000000 --record"
+    assert recorded_command(["bench", "--set", "a b"], [{}]) == "crowndemo bench --set 'a b'"

@@ -104,6 +104,16 @@ def _tank_numerics(items: Sequence[str]) -> Dict:
     return values
 
 
+def recorded_command(argv: Sequence[str], results) -> str:
+    """The command line a BENCHMARKS.md section gives, with the environment that changed what
+    ran (the slot-major neighbour list) in front, so that it repeats the run."""
+    from ..core.neighbours import LAYOUT_VARIABLE
+
+    env = [f"{LAYOUT_VARIABLE}=slot"] if any(r.get("list_layout") == "slot"
+                                             for r in results) else []
+    return " ".join(env + [PROG] + [shlex.quote(a) for a in argv])
+
+
 def _finish(args, argv: Sequence[str], results) -> None:
     from .. import bench
 
@@ -113,7 +123,7 @@ def _finish(args, argv: Sequence[str], results) -> None:
         print(bench.text_table(results))
     if args.record:
         path = os.path.join(repo_root(), "BENCHMARKS.md")
-        bench.record(results, " ".join([PROG] + [shlex.quote(a) for a in argv]), path)
+        bench.record(results, recorded_command(argv, results), path)
         print(f"{PROG}: appended to {path}", file=sys.stderr)
 
 
