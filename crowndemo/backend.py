@@ -45,6 +45,18 @@ def _finish() -> None:
     _current = None
 
 
+ON, OFF = ("1", "true", "yes", "on"), ("", "0", "false", "no", "off")
+
+
+def _switch(variable: str) -> bool:
+    """An on/off environment variable; another value is an error, not silently off."""
+    value = os.environ.get(variable, "").strip().lower()
+    if value not in ON + OFF:
+        raise BackendError(f"${variable} = {os.environ[variable]!r}: allowed 1, true, yes, on "
+                           "(on) or 0, false, no, off, empty (off)")
+    return value in ON
+
+
 def _arch_object(name: str):
     return {"cpu": ti.cpu, "cuda": ti.cuda, "vulkan": ti.vulkan, "gpu": ti.gpu}[name]
 
@@ -56,14 +68,14 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
 
     ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` is CUDA where
     Taichi finds it, else the CPU. ``single_thread`` makes CPU runs bit-reproducible.
-    ``fast_compile`` (None: ``$CROWNDEMO_FAST_COMPILE`` = 1) turns Taichi's advanced IR
+    ``fast_compile`` (None: ``$CROWNDEMO_FAST_COMPILE`` = 1, true, yes or on) turns Taichi's advanced IR
     optimisations off on the CPU arch: the 3D crown step compiles in 13-19 s instead of
     46-55 s and runs 5-10 % slower (BENCHMARKS.md, "Compiling"); no effect on other archs.
     A second call with the same settings is a no-op; with other settings Taichi is reset.
     """
     global _current
     if fast_compile is None:
-        fast_compile = os.environ.get("CROWNDEMO_FAST_COMPILE", "") == "1"
+        fast_compile = _switch("CROWNDEMO_FAST_COMPILE")
     arch = (arch or os.environ.get("CROWNDEMO_ARCH") or "cpu").lower()
     if arch not in ARCHS:
         raise BackendError(f"arch {arch!r} is not one of {', '.join(ARCHS)} "

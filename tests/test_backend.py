@@ -1,6 +1,7 @@
 """The backend choice (crowndemo.backend): ``auto`` never lands on Mesa's software Vulkan;
 ``--fast-compile`` turns Taichi's advanced IR optimisations off on the CPU arch only
 (BENCHMARKS.md, "Compiling": the 3D crown step compiles in about a third of the time)."""
+import pytest
 import taichi as ti
 from taichi.lang.misc import is_arch_supported
 
@@ -69,3 +70,16 @@ def test_a_recorded_slot_list_run_names_the_variable_that_repeats_it():
     assert recorded_command(argv, [{"list_layout": "slot"}]) == \
         "CROWNDEMO_LIST_LAYOUT=slot crowndemo bench --n 12000000 --record"
     assert recorded_command(["bench", "--set", "a b"], [{}]) == "crowndemo bench --set 'a b'"
+
+
+@pytest.mark.parametrize("value, on", [("1", True), ("yes", True), ("True", True), ("on", True),
+                                       ("", False), ("0", False), ("no", False), ("off", False)])
+def test_the_fast_compile_variable_reads_the_usual_words(monkeypatch, value, on):
+    monkeypatch.setenv("CROWNDEMO_FAST_COMPILE", value)
+    assert backend._switch("CROWNDEMO_FAST_COMPILE") is on
+
+
+def test_another_fast_compile_value_is_an_error_not_off(monkeypatch):
+    monkeypatch.setenv("CROWNDEMO_FAST_COMPILE", "maybe")
+    with pytest.raises(backend.BackendError, match="CROWNDEMO_FAST_COMPILE = 'maybe'"):
+        backend._switch("CROWNDEMO_FAST_COMPILE")

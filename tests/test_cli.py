@@ -57,6 +57,11 @@ def test_info_table(capsys):
     (["bench", "--preset", "nosuch-preset"], "nosuch-preset"),
     (["bench", "--preset", "quick", "--set", "scene.speed=-1"], "scene.speed"),
     (["bench", "--preset", "quick", "--max-steps", "0"], "max-steps"),
+    (["bench", "--set", "numerics.allow_unsafe_dt=true"], "numerics.allow_unsafe_dt"),
+    (["presets", "--rate", "0"], "--rate"),
+    (["presets", "--rate", "-1"], "--rate"),
+    (["scene", "tank", "--dim", "3", "--l0", "1e-5"], "--l0"),
+    (["scene", "dam-break", "--dim", "2", "--l0", "2e-6"], "--l0"),
     (["nosuch"], "nosuch"),
 ])
 def test_bad_input_exits_2_with_one_line(argv, key, capsys):
@@ -153,3 +158,47 @@ def test_scene_json(capsys):
     assert data["steps"] > 0 and data["time_s"] == pytest.approx(0.002)
     assert data["particles"]["fluid"] == 5000
     assert data["health"]["left_domain"] == {}
+
+
+@pytest.mark.parametrize("name, dim, l0", [("tank", 2, 1e-3), ("tank", 3, 1.3e-3),
+                                           ("dam-break", 2, 1e-3), ("dam-break", 3, 1.3e-3),
+                                           ("patch", 2, 1e-4), ("patch", 3, 1.3e-4)])
+def test_a_scene_is_counted_before_numpy_builds_it(name, dim, l0):
+    """The count that refuses a scene too large for one simulator (before Taichi starts or
+    numpy allocates its lattice) is the built scene's, within a few per cent."""
+    from crowndemo import scenes
+    from crowndemo.cli.scene import SCENES, _particles
+
+    val = {**SCENES[name]["defaults"][dim], "l0": l0}
+    if name == "tank":
+        built = scenes.hydrostatic_tank(dim=dim, l0=l0, width=val["width"], depth=val["depth"])
+    elif name == "dam-break":
+        built = scenes.dam_break(dim=dim, l0=l0, a=val["a"])
+    else:
+        built = scenes.square_patch(dim=dim, l0=l0, side=val["side"])
+    assert _particles(name, dim, val) == pytest.approx(len(built.pos), rel=0.07)
+
+
+def test_a_scene_too_large_is_refused_before_taichi_starts(monkeypatch, capsys):
+    from crowndemo.cli import scene
+
+    def started(args):
+        raise AssertionError("the backend started before the size check")
+    monkeypatch.setattr(scene, "start_backend", started)
+    assert main(["scene", "patch", "--dim", "3", "--l0", "1e-6"]) == 2
+    err = capsys.readouterr().err
+    assert "one simulator holds at most 38,347,922" in err     # core.step.max_particles, 3D
+
+
+def test_a_closed_stdout_ends_quietly():
+    """`crowndemo info ... | head -1`: exit 141 (128 + SIGPIPE), no traceback."""
+    import subprocess
+    import sys
+    proc = subprocess.Popen([sys.executable, "-m", "crowndemo", "info", "2m-drop", "--set",
+                             "scene.height=1.5"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.readline()
+    proc.stdout.close()                   # the reader goes away after one line
+    err = proc.stderr.read().decode()
+    assert proc.wait() == 141, err
+    assert "Traceback" not in err and "BrokenPipe" not in err

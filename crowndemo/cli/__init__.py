@@ -2,7 +2,7 @@
 
 User mistakes (bad flags, parameters out of range, an unavailable arch) print one line
 ``crowndemo: error: ...`` on stderr and return 2; an unstable run prints the reason and
-returns 3; Ctrl-C returns 130.
+returns 3; Ctrl-C returns 130; a closed stdout (``| head``) returns 141 quietly.
 """
 from __future__ import annotations
 
@@ -40,7 +40,7 @@ examples:
 
 Run 'crowndemo COMMAND --help' for the options of a command.
 Exit status: 0 ok, 2 a usage or parameter error, 3 the simulation became unstable,
-130 interrupted (Ctrl-C).
+130 interrupted (Ctrl-C), 141 stdout closed early (a pipe into head).
 """
 
 
@@ -76,6 +76,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader of stdout went away (`crowndemo info ... | head`): no traceback, and
+        # nothing more written to the closed pipe, exit flush included
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141        # 128 + SIGPIPE, as a shell reports a command killed by it
 
 
 __all__ = ["main", "build_parser", "COMMANDS"]

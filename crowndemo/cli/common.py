@@ -26,7 +26,8 @@ OPTION_OF = {"dim": "--dim", "l0": "--l0", "v_max": "--speed", "re_ratio": "--re
              "rho": "--rho", "nu": "--nu", "sigma": "--sigma", "sound_speed": "--sound-speed",
              "pressure_gradient": "--gradient", "t_end": "--t-end", "width": "--width",
              "depth": "--depth", "a": "--a", "side": "--side", "n": "--n", "steps": "--steps",
-             "courant": "--courant", "acoustic": "--acoustic", "max_steps": "--max-steps"}
+             "courant": "--courant", "acoustic": "--acoustic", "max_steps": "--max-steps",
+             "rate": "--rate"}
 
 
 class UsageError(Exception):

@@ -3,9 +3,11 @@ estimates per quality."""
 from __future__ import annotations
 
 import json
+import math
 import os
 
 from ..config import PresetError
+from ..core.params import ParameterError
 from .common import (Fmt, error)
 
 
@@ -40,6 +42,9 @@ def _presets(args) -> int:
     from .. import config
     from ..config import estimate, schema
 
+    if args.rate is not None and not (math.isfinite(args.rate) and args.rate > 0):
+        raise ParameterError("rate", args.rate, "> 0 fluid particle-steps per second",
+                             "command line")
     tp = estimate.throughput(rate=args.rate)
     folder = config.presets_dir()
     rows, errors = [], []

@@ -31,7 +31,7 @@ SCENE_HELP = {
 
 SCENE_EPILOG = """\
 examples:
-  crowndemo scene dam-break --dim 3 --t-end 0.05      # what `make demo` runs
+  crowndemo scene dam-break --dim 3 --t-end 0.05      # a short 3D dam break
   crowndemo scene dam-break --dim 2 --l0 5e-4 --gradient sum
   crowndemo scene tank --dim 2 --depth 0.08 --t-end 0.3
   crowndemo scene patch --dim 3 --side 3e-3 --sigma 0.05 --json
@@ -51,8 +51,34 @@ def _positive(key: str, value: float, unit: str) -> None:
         raise ParameterError(key, value, f"> 0 {unit}".rstrip(), "command line")
 
 
-def _build_scene(name: str, args):
-    from .. import scenes
+def _particles(name: str, dim: int, val: Dict) -> int:
+    """The scene's particles, counted before numpy builds it: the fluid block and the shell of
+    wall and dummy layers around the container (hydrostatic_tank, dam_break and square_patch
+    in scenes/reference.py; within a few per cent)."""
+    from ..core.lattice import wall_layers
+
+    l0 = val["l0"]
+    layers = wall_layers(2.1)                  # the builders' default re = 2.1 l0
+    points = lambda extents: math.prod(int(e / l0 + 1e-9) for e in extents)
+    if name == "patch":
+        return points([val["side"]] * dim)
+    if name == "tank":
+        w, h = val["width"], val["depth"]
+        inner, fluid = [w] * (dim - 1) + [h + max(4 * l0, 0.25 * h)], [w] * (dim - 1) + [h]
+    else:
+        a = val["a"]
+        inner, fluid = [4.0 * a] + [a] * (dim - 2) + [2.5 * a], [a] * (dim - 1) + [2.0 * a]
+    # walls on every side face and the floor: layers more points each way, one way up
+    outer = [e + 2 * layers * l0 for e in inner[:-1]] + [inner[-1] + layers * l0]
+    return points(fluid) + points(outer) - points(inner)
+
+
+def _values(name: str, args, numerics: Numerics) -> Dict:
+    """The scene's options with their defaults, checked (a ParameterError names the option)
+    before Taichi starts or numpy allocates: positive sizes, sizes of at least l0, and at
+    most the particles one simulator holds (core/step.py, max_particles)."""
+    from ..core.params import Model
+    from ..core.step import max_particles
 
     d = SCENES[name]["defaults"][args.dim]
     val = {k: (getattr(args, k) if getattr(args, k, None) is not None else v)
@@ -64,8 +90,27 @@ def _build_scene(name: str, args):
             _positive(k, val[k], "m")
             if val[k] < val["l0"]:
                 raise ParameterError(k, val[k], f">= l0 = {val['l0']:g} m", "command line")
-    numerics = Numerics(pressure_gradient=args.gradient, courant=args.courant,
-                        acoustic=args.acoustic)
+    model = Model(args.dim, False, False, False, numerics.pressure_gradient,
+                  numerics.collision > 0, numerics.neighbour_list)
+    limit = max_particles(model)
+    n = _particles(name, args.dim, val)
+    if n > limit:
+        coarsest = val["l0"] * (n / limit) ** (1.0 / args.dim)
+        raise ParameterError("l0", val["l0"],
+                             f">= {coarsest:.3g} m for this scene's sizes: at l0 = "
+                             f"{val['l0']:g} m it has ~{n:,} particles, one simulator holds "
+                             f"at most {limit:,}", "command line")
+    return val
+
+
+def _numerics(args) -> Numerics:
+    return Numerics(pressure_gradient=args.gradient, courant=args.courant,
+                    acoustic=args.acoustic)
+
+
+def _build_scene(name: str, args, val: Dict, numerics: Numerics):
+    from .. import scenes
+
     common = dict(dim=args.dim, l0=val["l0"], t_end=val["t_end"], numerics=numerics)
     if name == "tank":
         sc = scenes.hydrostatic_tank(width=val["width"], depth=val["depth"], nu=val["nu"],
@@ -76,7 +121,7 @@ def _build_scene(name: str, args):
         sc = scenes.square_patch(side=val["side"], sigma=val["sigma"], **common)
     sc.physics.validate("command line")
     sc.numerics.validate("command line")
-    return sc, val
+    return sc
 
 
 def _observables(name: str, scene, sim) -> Dict:
@@ -129,9 +174,12 @@ def _scene(args) -> int:
     from ..core import simulator_for
 
     name = args.scene
+    numerics = _numerics(args)
+    numerics.validate("command line")
+    val = _values(name, args, numerics)        # every option checked before Taichi starts
     be = start_backend(args)
     t0 = time.perf_counter()
-    scene, val = _build_scene(name, args)
+    scene = _build_scene(name, args, val, numerics)
     sim = simulator_for(scene)
     setup_s = time.perf_counter() - t0
     t_end = val["t_end"]
