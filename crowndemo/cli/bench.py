@@ -16,7 +16,7 @@ from .common import PROG, Fmt, Progress, repo_root, start_backend
 BENCH_EPILOG = """\
 examples:
   crowndemo bench                             # N = 100000 and 300000, 20 steps, table
-  crowndemo bench --n 2000 --steps 3 --json   # a quick check
+  crowndemo bench --n 2000 --steps 3 --json   # a small run (compiling the kernels takes most of it)
   crowndemo bench --arch cuda --n 1000000     # on an NVIDIA GPU
   crowndemo bench --record                    # append the results to BENCHMARKS.md
   crowndemo bench --compare --n 100000        # the seed's formulation against the tuned one
