@@ -4,6 +4,9 @@ import math
 
 import pytest
 
+from crowndemo.cli import live as live_cli
+from crowndemo.cli import main
+from crowndemo.render import window
 from crowndemo.render.live_control import LiveController, overrides
 
 SETS = ["quality.draft.l0=2e-4"]          # quick-2d, coarser: a cheap 2D run
@@ -55,3 +58,39 @@ def test_drop_restarts_the_run(controller):
     assert not controller.drop()
     assert "film" in controller.error and controller.runs == 2
     assert controller.sim is sim and controller.time == t
+
+
+@pytest.fixture
+def no_backend(monkeypatch):
+    """Fails the test if `crowndemo live` gets as far as starting Taichi."""
+    monkeypatch.setattr(live_cli, "start_backend", lambda args: pytest.fail("backend started"))
+
+
+def test_live_without_a_display_gives_its_own_advice(monkeypatch, capsys, no_backend):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["live"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("crowndemo: error: no display (DISPLAY unset); live mode needs a "
+                          "window; without one, use 'crowndemo record PRESET', then "
+                          "'crowndemo play --headless --out FILE.mp4'")
+    assert err.count("\n") == 1
+
+
+def test_live_with_no_x_server(monkeypatch, tmp_path, capsys, no_backend):
+    monkeypatch.setattr(window, "X11_SOCKET_DIR", str(tmp_path))
+    monkeypatch.setenv("DISPLAY", ":99")
+    assert main(["live"]) == 2
+    assert "error: cannot open a window on DISPLAY :99 (no X server answers" in \
+        capsys.readouterr().err
+
+
+def test_live_reports_a_misspelt_preset_before_the_display(monkeypatch, capsys, no_backend):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["live", "qiuck"]) == 2
+    err = capsys.readouterr().err
+    assert "preset = 'qiuck'" in err and "did you mean 'quick'" in err
+    assert "display" not in err
+    assert main(["live", "--set", "scene.film=-1"]) == 2     # --set values too
+    assert "scene.film" in capsys.readouterr().err

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from crowndemo.cli import main
-from crowndemo.render import player
+from crowndemo.cli import play as play_cli
+from crowndemo.render import player, window
 from crowndemo.render.video import encode_mp4, read_video, write_png
 
 SIZE = (64, 36)
@@ -91,3 +92,60 @@ def test_play_errors(recordings, tmp_path):
     assert play(recordings, tmp_path / "x.mp4", "nosuch") == 2
     assert play(recordings, tmp_path / "x.mp4", "broken") == 2      # only incomplete ones
     assert main(["play", "--headless", "--recordings", str(recordings)]) == 2   # no --out
+
+
+@pytest.mark.parametrize("name", ["r.txt", "reel", "reel.gif"])
+def test_out_must_be_an_mp4_file(tmp_path, capsys, name):
+    """Checked first: even before finding that there are no recordings."""
+    out = tmp_path / name
+    assert play(tmp_path / "none", out) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"crowndemo: error: --out {out}: ") and "ending in .mp4" in err
+    assert err.count("\n") == 1 and not out.exists()
+
+
+def test_out_in_a_folder_that_cannot_be_made(recordings, tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    assert play(recordings, blocker / "reel.mp4") == 2
+    assert f"--out {blocker / 'reel.mp4'}: cannot write into {blocker}" in \
+        capsys.readouterr().err
+    assert play(recordings, tmp_path / "new" / "sub" / "reel.mp4") == 0   # made when missing
+
+
+def test_recordings_default_follows_the_environment(recordings, tmp_path, monkeypatch,
+                                                   capsys):
+    """As record: --recordings, else $CROWNDEMO_RECORDINGS, else ./recordings."""
+    def play_default(out):
+        return main(["play", "--headless", "--out", str(out), "--resolution", "%dx%d" % SIZE,
+                     "--fps", str(FPS), "--card-seconds", "0"])
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)                       # no ./recordings here
+    monkeypatch.setenv("CROWNDEMO_RECORDINGS", str(recordings))
+    assert play_default(tmp_path / "env.mp4") == 0
+    assert len(list(read_video(str(tmp_path / "env.mp4")))) == 2 + 3     # green, red
+    monkeypatch.delenv("CROWNDEMO_RECORDINGS")
+    assert play_default(tmp_path / "none.mp4") == 2
+    assert "no recordings in recordings/" in capsys.readouterr().err
+    monkeypatch.chdir(tmp_path)                        # ./recordings is the fixture's
+    assert play_default(tmp_path / "cwd.mp4") == 0
+
+
+def test_help_names_the_recordings_default(capsys):
+    assert main(["play", "--help"]) == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "--recordings DIR the folder of recordings (default: $CROWNDEMO_RECORDINGS, " \
+           "else ./recordings)" in help_text
+
+
+def test_window_needs_an_x_server(recordings, tmp_path, monkeypatch, capsys):
+    """DISPLAY set but no server (ssh without X forwarding): an error before GLFW or Taichi."""
+    monkeypatch.setattr(window, "X11_SOCKET_DIR", str(tmp_path / "no-x11"))
+    monkeypatch.setenv("DISPLAY", ":99")
+    monkeypatch.setattr(play_cli, "start_backend", lambda args: pytest.fail("backend started"))
+    monkeypatch.setattr(player, "play_in_window", lambda *a: pytest.fail("window opened"))
+    assert main(["play", "--recordings", str(recordings)]) == 2
+    err = capsys.readouterr().err
+    assert "crowndemo: error: cannot open a window on DISPLAY :99 (no X server answers" in err
+    assert err.rstrip().endswith("use --headless --out FILE.mp4 to play into a video file")

@@ -179,6 +179,18 @@ def test_sink_writes_frames_video_and_preview(renderer, tmp_path):
     assert len(glob.glob(str(out / "frames" / "frame_*.png"))) == 1
 
 
+def test_video_writer_writes_mp4_only(tmp_path):
+    """Another suffix is refused by name before ffmpeg starts (it would fail on the uri)."""
+    from crowndemo.render.video import VideoWriter, encode_mp4, read_video
+    frame = np.zeros((8, 8, 3), np.uint8)
+    for name in ("reel.txt", "reel.gif", "reel"):
+        with pytest.raises(ValueError, match=r"must end in \.mp4"):
+            VideoWriter(str(tmp_path / name), 10)
+    assert not os.listdir(tmp_path)
+    assert encode_mp4([frame] * 2, str(tmp_path / "REEL.MP4"), 10) == 2     # any case
+    assert len(list(read_video(str(tmp_path / "REEL.MP4")))) == 2
+
+
 def test_render_options_and_sink_from_args(tmp_path):
     import argparse
 

@@ -1,7 +1,7 @@
 """``crowndemo live``: the interactive booth mode (sliders, a Drop button, a live run)."""
 from __future__ import annotations
 
-from .common import SET_HELP, Fmt, start_backend
+from .common import PROG, SET_HELP, Fmt, start_backend
 
 LIVE_EPILOG = """\
 examples:
@@ -17,18 +17,22 @@ the panel to orbit the camera; Up/Down zoom; Esc quits. Needs a display and Vulk
 """
 
 
+NO_DISPLAY_ADVICE = (f"live mode needs a window; without one, use '{PROG} record PRESET', "
+                     f"then '{PROG} play --headless --out FILE.mp4'")
+
+
 def _live(args, argv) -> int:
     from ..render import options
     from ..render.live import run_live
     from ..render.live_control import LiveController
-    from ..render.player import require_display
-    from ..render.window import check_available
+    from ..render.window import check_available, require_display
 
-    require_display()
     settings = options.settings_from_args(args)
+    # the preset and --set values first (no Taichi yet), then the display, then Vulkan
+    controller = LiveController(args.preset, args.quality, sets=args.sets)
+    require_display(NO_DISPLAY_ADVICE)
     start_backend(args)
     check_available()
-    controller = LiveController(args.preset, args.quality, sets=args.sets)
     run_live(controller, settings)
     return 0
 

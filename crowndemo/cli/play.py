@@ -1,6 +1,7 @@
 """``crowndemo play``: the booth loop over recordings, in a window or into a video file."""
 from __future__ import annotations
 
+import os
 import sys
 
 from .common import PROG, Fmt, UsageError, start_backend
@@ -13,27 +14,53 @@ examples:
   crowndemo play --headless --out reel.mp4 --loops 1   # the booth reel as a video file
   crowndemo play recordings/quick --partial        # a folder; play it even if incomplete
 
-A recording is a folder recordings/NAME (see 'crowndemo record') with frames/frame_*.png or
-video.mp4. Each is preceded by a title card (the preset's title and description). A recording
-whose metadata.json does not say "status": "complete" (without metadata: that has no
-video.mp4) is skipped with a warning; --partial plays it with an "incomplete" marker.
+A recording is a folder RECORDINGS/NAME (see 'crowndemo record'; RECORDINGS: --recordings,
+$CROWNDEMO_RECORDINGS, else ./recordings) with frames/frame_*.png or video.mp4. Each is
+preceded by a title card (the preset's title and description). A recording whose
+metadata.json does not say "status": "complete" (without metadata: that has no video.mp4)
+is skipped with a warning; --partial plays it with an "incomplete" marker.
 The window opens at the top-left corner at --resolution (GGUI has no full-screen mode: give
 the screen's size); Esc or closing it stops. Without a display, use --headless --out.
 """
 
 
-def _play(args, argv) -> int:
-    from ..render import player
-    from ..render.window import check_available
+def _check_out(out: str) -> None:
+    """UsageError unless ``out`` is a video file name that can be written."""
+    from ..render.video import VIDEO_SUFFIXES
+    if os.path.splitext(out)[1].lower() not in VIDEO_SUFFIXES:
+        raise UsageError(f"--out {out}: the reel is written as H.264 MP4; give a file name "
+                         "ending in " + " or ".join(VIDEO_SUFFIXES))
+    if os.path.isdir(out):
+        raise UsageError(f"--out {out}: is a folder; give a video file name")
+    folder = os.path.dirname(os.path.abspath(out))
+    while not os.path.exists(folder):                # the nearest folder that exists
+        folder = os.path.dirname(folder)
+    if not os.path.isdir(folder) or not os.access(folder, os.W_OK | os.X_OK):
+        raise UsageError(f"--out {out}: cannot write into {folder}")
 
+
+def _check_args(args) -> None:
+    """UsageError for a bad option; fills in the defaults that depend on others."""
+    from ..record import recordings_root
     if args.loops is not None and args.loops < 1:
         raise UsageError(f"--loops {args.loops}: must be >= 1")
     if args.fps <= 0 or args.card_seconds < 0:
         raise UsageError("--fps must be > 0 and --card-seconds >= 0")
     if args.headless and not args.out:
         raise UsageError("--headless needs --out FILE.mp4")
-    if args.headless and args.loops is None:
-        args.loops = 1                         # a file cannot loop forever
+    if args.headless:
+        _check_out(args.out)
+        if args.loops is None:
+            args.loops = 1                     # a file cannot loop forever
+    if not args.dir:                           # as record: $CROWNDEMO_RECORDINGS, else ./
+        args.dir = os.fspath(recordings_root())
+
+
+def _play(args, argv) -> int:
+    from ..render import player
+    from ..render.window import check_available
+
+    _check_args(args)
     names = args.recordings or player.list_recordings(args.dir)
     if not names:
         raise UsageError(f"no recordings in {args.dir}/ (make one with '{PROG} record PRESET')")
@@ -63,7 +90,7 @@ def _play(args, argv) -> int:
 def register(sub, common) -> None:
     from ..render.captions import LANGS
     from ..render.options import parse_resolution
-    from ..render.player import CARD_SECONDS, DEFAULT_ROOT
+    from ..render.player import CARD_SECONDS
     from ..render.renderer import BOOTH_RESOLUTION
 
     p = sub.add_parser("play", parents=common, formatter_class=Fmt, epilog=PLAY_EPILOG,
@@ -74,8 +101,9 @@ def register(sub, common) -> None:
     p.add_argument("recordings", nargs="*", metavar="PRESET",
                    help="recordings to play: names under --recordings or folder paths "
                         "(default: all)")
-    p.add_argument("--recordings", dest="dir", metavar="DIR", default=DEFAULT_ROOT,
-                   help="the folder of recordings (default: %(default)s)")
+    p.add_argument("--recordings", dest="dir", metavar="DIR",
+                   help="the folder of recordings (default: $CROWNDEMO_RECORDINGS, else "
+                        "./recordings)")
     p.add_argument("--loops", type=int, default=None,
                    help="play the list N times (default: forever; 1 with --headless)")
     p.add_argument("--headless", action="store_true",

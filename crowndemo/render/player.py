@@ -23,7 +23,7 @@ from PIL import Image
 
 from . import video
 from .captions import effective_lang, mark, title_card
-from .window import RenderError, close_window, open_window
+from .window import close_window, open_window
 
 DEFAULT_ROOT = "recordings"
 CARD_SECONDS = 3.0
@@ -201,10 +201,9 @@ def play_in_window(frames: Iterator[np.ndarray], size: Tuple[int, int], fps: flo
 
 
 def require_display() -> None:
-    from .window import has_display
-    if not has_display():
-        raise RenderError("no display (DISPLAY or WAYLAND_DISPLAY unset): use --headless "
-                          "--out FILE.mp4 to play into a video file")
+    """RenderError unless the booth window can open, saying how to play without one."""
+    from .window import require_display as require
+    require("use --headless --out FILE.mp4 to play into a video file")
 
 
 __all__ = ["Recording", "PlayError", "open_recording", "list_recordings", "select", "reel",

@@ -11,6 +11,7 @@ from PIL import Image
 
 GIF_WIDTH = 320          # pixels: the preview's width
 GIF_FRAMES = 24          # at most this many frames in the preview
+VIDEO_SUFFIXES = (".mp4",)   # what VideoWriter writes: H.264 in an MP4 container
 
 
 def _tmp(path: str) -> str:
@@ -37,12 +38,20 @@ def even(image: np.ndarray) -> np.ndarray:
     return image[: h - h % 2, : w - w % 2]
 
 
+def check_video_path(path: str) -> None:
+    """ValueError unless ``path`` names a kind of video file that VideoWriter writes."""
+    if os.path.splitext(path)[1].lower() not in VIDEO_SUFFIXES:
+        raise ValueError(f"{path}: a video file must end in " + " or ".join(VIDEO_SUFFIXES)
+                         + " (H.264 MP4)")
+
+
 class VideoWriter:
     """An H.264 MP4 written frame by frame to a temporary name; ``close(keep=True)`` renames
     it to ``path``, ``close(keep=False)`` deletes it."""
 
     def __init__(self, path: str, fps: float):
         import imageio.v2 as iio
+        check_video_path(path)
         self.path, self.tmp = path, _tmp(path)
         self.frames = 0
         self._writer = iio.get_writer(self.tmp, format="FFMPEG", fps=fps, codec="libx264",
@@ -109,5 +118,5 @@ def read_video(path: str) -> Iterable[np.ndarray]:
         reader.close()
 
 
-__all__ = ["write_png", "read_image", "even", "VideoWriter", "encode_mp4", "encode_gif",
-           "read_video"]
+__all__ = ["write_png", "read_image", "even", "check_video_path", "VIDEO_SUFFIXES",
+           "VideoWriter", "encode_mp4", "encode_gif", "read_video"]

@@ -11,18 +11,27 @@ Facts of Taichi 1.7.4 that this module handles in one place:
   process), so one window is open at a time: opening a second is a RenderError. Share one
   Renderer (``FrameSink(renderer=...)``) or close the first.
 - A window must be created after ``ti.init`` (``crowndemo.backend.init``).
+- An on-screen window goes through GLFW, built for X11 only on Linux; when DISPLAY names no
+  X server it prints "cannot initialize GLFW" and may crash the process, so
+  ``require_display`` checks that an X server answers first.
 """
 from __future__ import annotations
 
 import atexit
 import glob
 import os
-from typing import List, Optional, Tuple
+import socket
+import sys
+from typing import List, Optional, Tuple, Union
 
 INSTALL_HINT = ("install a Vulkan driver: on Debian/Ubuntu 'apt-get install "
                 "mesa-vulkan-drivers' (lavapipe, a software driver that needs no GPU), or "
                 "your GPU vendor's driver")
 ICD_DIRS = ("/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d")
+
+X11_SOCKET_DIR = "/tmp/.X11-unix"   # a local X server's socket X<N> for DISPLAY=:N
+X11_TCP_PORT = 6000                 # + N: a remote X server (DISPLAY=HOST:N, e.g. over ssh -X)
+CONNECT_TIMEOUT_S = 1.0
 
 _open: List[object] = []            # windows not yet destroyed
 IMGUI_INI = "imgui.ini"             # Dear ImGui (inside GGUI) writes this into the cwd
@@ -97,10 +106,67 @@ def check_available() -> None:
     _checked = True
 
 
+def _connects(address: Union[str, Tuple[str, int]]) -> bool:
+    """Whether a stream socket connects to ``address`` (a unix socket path, or (host, port))
+    within CONNECT_TIMEOUT_S."""
+    try:
+        if isinstance(address, tuple):
+            socket.create_connection(address, CONNECT_TIMEOUT_S).close()
+        else:
+            with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as s:
+                s.settimeout(CONNECT_TIMEOUT_S)
+                s.connect(address)
+        return True
+    except (OSError, ValueError):                         # ValueError: a NUL in a path
+        return False
+
+
+def x11_problem(display: str) -> Optional[str]:
+    """None when an X server answers on ``display`` ([HOST]:N[.S]), else why not: the local
+    socket X11_SOCKET_DIR/XN (or its abstract twin) when HOST is empty or "unix", else TCP
+    port 6000 + N on HOST."""
+    host, colon, rest = display.rpartition(":")
+    number = rest.split(".", 1)[0]
+    if not colon or not number.isdigit():
+        return "not of the form [HOST]:N[.S]"
+    if host in ("", "unix"):
+        path = os.path.join(X11_SOCKET_DIR, "X" + number)
+        if _connects("\0" + path) or _connects(path):   # Linux servers listen on both
+            return None
+        return f"no X server answers on {path}"
+    port = X11_TCP_PORT + int(number)
+    if _connects((host, port)):
+        return None
+    return f"no X server answers at {host}:{port}"
+
+
+def display_problem() -> Optional[str]:
+    """None when an on-screen GGUI window can open, else why not. Taichi 1.7.4's GLFW talks
+    X11 only on Linux, so a Wayland session needs XWayland (which sets DISPLAY)."""
+    if sys.platform in ("darwin", "win32"):
+        return None                                       # the system's own windows
+    display = os.environ.get("DISPLAY")
+    if display:
+        problem = x11_problem(display)
+        return problem and f"cannot open a window on DISPLAY {display} ({problem})"
+    if os.environ.get("WAYLAND_DISPLAY"):
+        return ("cannot open a window: WAYLAND_DISPLAY is set but DISPLAY is not, and "
+                "Taichi's GGUI opens windows through X11 only (start XWayland)")
+    return "no display (DISPLAY unset)"
+
+
 def has_display() -> bool:
-    """Whether an on-screen window can be shown (X11 or Wayland)."""
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    """Whether an on-screen window can be shown (an X server answers on $DISPLAY)."""
+    return display_problem() is None
+
+
+def require_display(advice: str) -> None:
+    """RenderError ("<why not>; <advice>") unless an on-screen window can open; call it
+    before GLFW is touched (Taichi crashes when GLFW cannot reach the display)."""
+    problem = display_problem()
+    if problem:
+        raise RenderError(f"{problem}; {advice}")
 
 
 __all__ = ["RenderError", "INSTALL_HINT", "open_window", "close_window", "check_available",
-           "icd_files", "has_display"]
+           "icd_files", "has_display", "display_problem", "require_display", "x11_problem"]
