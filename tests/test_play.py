@@ -92,6 +92,9 @@ def test_play_errors(recordings, tmp_path):
     assert play(recordings, tmp_path / "x.mp4", "nosuch") == 2
     assert play(recordings, tmp_path / "x.mp4", "broken") == 2      # only incomplete ones
     assert main(["play", "--headless", "--recordings", str(recordings)]) == 2   # no --out
+    # --out without --headless would be ignored by the window: refused
+    assert main(["play", "--out", str(tmp_path / "x.mp4"), "--recordings", str(recordings)]) == 2
+    assert not (tmp_path / "x.mp4").exists()
 
 
 @pytest.mark.parametrize("name", ["r.txt", "reel", "reel.gif"])

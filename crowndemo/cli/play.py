@@ -48,6 +48,9 @@ def _check_args(args) -> None:
         raise UsageError("--fps must be > 0 and --card-seconds >= 0")
     if args.headless and not args.out:
         raise UsageError("--headless needs --out FILE.mp4")
+    if args.out and not args.headless:
+        raise UsageError(f"--out {args.out}: only with --headless (without it the reel plays "
+                         "in a window)")
     if args.headless:
         _check_out(args.out)
         if args.loops is None:
