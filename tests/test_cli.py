@@ -132,10 +132,11 @@ def test_bench_preset_json(capsys):
 
 
 def test_bench_preset_unstable_reports_the_finished_ones(tmp_path, capsys):
-    # the drop falls at U = c/5 from the start: with max_mach = 0.1 a run stops at step 1.
+    # the drop starts at U = c/5: max_mach * c just above U passes the preset's check
+    # (config/resolve.py), and gravity takes the falling drop past it in the first step.
     # quick-2d finishes its 2 steps first; its row is printed, then the one-line error.
     bad = tmp_path / "unstable.yaml"
-    bad.write_text("extends: quick\nnumerics: {max_mach: 0.1}\n")
+    bad.write_text("extends: quick\nnumerics: {max_mach: 0.2000001}\n")
     assert main(["bench", "--preset", "quick-2d", str(bad), "--quality", "draft",
                  "--max-steps", "2", "--no-stages"]) == 3
     out, err = capsys.readouterr()

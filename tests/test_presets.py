@@ -237,7 +237,7 @@ BAD = [  # (id, file text, quality, fragments of the message after "<file>: ")
     ("not YAML", GOOD + "  bad: [1, 2\n", "draft", ["not valid YAML at line"]),
     ("not a mapping", "- 1\n- 2\n", "draft", ["not a preset: the top level must be a mapping"]),
     ("duplicate key", _with("  gap: 5.0e-4\n", "  gap: 5.0e-4\n  gap: 1.0e-3\n"), "draft",
-     ["gap = (missing): key given twice in one mapping (line"]),
+     ["scene.gap = 0.001: key given twice in one mapping (line 8, column 3)"]),
     ("extends nothing", "extends: nosuch-preset\n" + GOOD, "draft",
      ["extends = 'nosuch-preset': no such preset in", "allowed: ", "3m-drop"]),
 ]

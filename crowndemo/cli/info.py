@@ -178,6 +178,11 @@ def _preset_facts(r, tp) -> Dict:
     }
 
 
+def _speed_in_c(v: float, c: float) -> str:
+    """'8 m/s = 0.2 c': a speed and its ratio to the sound speed c."""
+    return f"{v:.3g} m/s = {v / c:.2g} c"
+
+
 def _mm(x: float) -> str:
     return f"{x * 1e3:.4g} mm"
 
@@ -266,10 +271,10 @@ def _info_preset(args) -> int:
               f"(Taichi's 32-bit field indices): a run would be refused; l0 >= ~{_mm(need)}")
     print(f"  memory      ~{estimate.human_bytes(f['memory_bytes'])} ({tp.bytes_per_particle:g} "
           f"bytes per particle with the cell grid, f32)")
-    speeds = (f"the splash's ~{f['splash_speed_m_s']:.3g} m/s = {estimate.SPLASH_MACH:g} c")
+    c = f["sound_speed_m_s"]          # the speeds are max(U, k c): state their own ratio
+    speeds = f"the splash's ~{_speed_in_c(f['splash_speed_m_s'], c)}"
     if relative:
-        speeds = (f"a relative speed of ~{f['relative_speed_m_s']:.3g} m/s = "
-                  f"{estimate.SPLASH_RELATIVE_MACH:g} c, {speeds}")
+        speeds = f"a relative speed of ~{_speed_in_c(f['relative_speed_m_s'], c)}, {speeds}"
     print(f"  steps       ~{f['steps']:,} to t_end: dt {f['dt_s']:.3g} s until contact, then "
           f"{f['dt_after_contact_s']:.3g} s ({f['binding_after_contact']} at {speeds}); at "
           f"least {f['steps_at_U']:,} (v = U all along)")

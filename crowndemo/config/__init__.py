@@ -19,7 +19,7 @@ from __future__ import annotations
 from typing import Iterable, Optional
 
 from .errors import PresetError
-from .loader import Document, display, find, preset_names, presets_dir
+from .loader import COMMAND_LINE, Document, display, find, preset_names, presets_dir
 from .resolve import Resolved, resolve
 from .schema import LIQUIDS, QUALITIES
 
@@ -27,14 +27,14 @@ DEFAULT_QUALITY = "draft"
 
 
 def load_document(spec: str, sets: Optional[Iterable[str]] = None,
-                  source: str = "command line") -> Document:
+                  source: str = COMMAND_LINE) -> Document:
     """A preset (name or path) with its extends chain and the ``--set`` overrides merged."""
     from . import loader, overrides
     return overrides.apply(loader.load(spec, source), sets or ())
 
 
 def load(spec: str, quality: str = DEFAULT_QUALITY, sets: Optional[Iterable[str]] = None,
-         source: str = "command line") -> Resolved:
+         source: str = COMMAND_LINE) -> Resolved:
     """Load, override, validate and resolve a preset; PresetError on the first mistake."""
     return resolve(load_document(spec, sets, source), quality)
 

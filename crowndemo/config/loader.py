@@ -3,28 +3,36 @@ path); ``extends: OTHER`` loads OTHER first (a preset name, or a path relative t
 extends it) and deep-merges this file onto it.
 
 The presets folder is ``presets/`` at the repository root, next to the ``crowndemo`` package;
-``$CROWNDEMO_PRESETS`` names another folder. Files whose name starts with ``_`` are not listed
-(bases meant only to be extended) but can still be named.
+``$CROWNDEMO_PRESETS`` names another folder (an error when it is none). Files whose name
+starts with ``_`` are not listed (bases meant only to be extended) but can still be named.
 """
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 from .errors import PresetError, did_you_mean
-from .merge import Origin, deep_merge, origin_of
+from .merge import DEFAULT_SOURCE, SET_SOURCE, Origin, deep_merge, origin_of
 from .yamlio import load_text
 
 SUFFIXES = (".yaml", ".yml")
 MAX_DEPTH = 16
+COMMAND_LINE = "command line"    # the source of a preset named on the command line
 
 
 def presets_dir() -> Path:
+    """The presets folder; PresetError when ``$CROWNDEMO_PRESETS`` names no folder."""
     env = os.environ.get("CROWNDEMO_PRESETS")
     if env:
-        return Path(env).expanduser()
+        folder = Path(env).expanduser()
+        if not folder.is_dir():
+            why = "not a folder" if folder.exists() else "no such folder"
+            raise PresetError("$CROWNDEMO_PRESETS", None, why=f"{why}: {env}",
+                              allowed="an existing folder of preset .yaml files, or unset "
+                                      "for presets/ next to the crowndemo package")
+        return folder
     import crowndemo
     return Path(crowndemo.__file__).resolve().parent.parent / "presets"
 
@@ -50,32 +58,56 @@ def looks_like_path(spec: str) -> bool:
     return spec.endswith(SUFFIXES) or "/" in spec or os.sep in spec
 
 
-def find(spec: str, source: str = "command line", key: str = "preset",
+def find(spec: str, source: str = COMMAND_LINE, key: str = "preset",
          relative_to: Optional[Path] = None) -> Path:
     """The file of a preset name or path; a path is taken relative to ``relative_to``
     (the folder of the file that names it) when given."""
     if not isinstance(spec, str) or not spec.strip():
         raise PresetError(source, key, spec, "not a preset name or path",
                           "a preset name (crowndemo presets) or a path to a .yaml file")
-    folder = presets_dir()
     if looks_like_path(spec):
         path = Path(spec).expanduser()
         if relative_to is not None and not path.is_absolute():
             path = relative_to / path
         if path.is_file():
             return path.resolve()
+        _not_a_folder(path, source, key, spec)
         raise PresetError(source, key, spec, f"no such file ({display(path)})",
                           "an existing .yaml file, or a preset name")
+    folder = presets_dir()
     for suffix in SUFFIXES:
         path = folder / f"{spec}{suffix}"
         if path.is_file():
             return path.resolve()
     if Path(spec).is_file():          # a file without the .yaml suffix, in the working folder
         return Path(spec).resolve()
+    if relative_to is None:
+        _not_a_folder(Path(spec), source, key, spec)
     names = preset_names(folder)
     raise PresetError(source, key, spec,
                       f"no such preset in {display(folder)}{did_you_mean(spec, names)}",
                       (", ".join(names) or "(none)") + ", or a path to a .yaml file")
+
+
+def _not_a_folder(path: Path, source: str, key: str, spec: str) -> None:
+    """PresetError when ``path`` is a folder: named by itself on the command line, else by
+    the file (``extends``) that names it."""
+    if not path.is_dir():
+        return
+    allowed = "a preset .yaml file, or a preset name (crowndemo presets)"
+    if source == COMMAND_LINE:
+        raise PresetError(display(path), None, why="a folder, not a preset file",
+                          allowed=allowed)
+    raise PresetError(source, key, spec, f"a folder, not a preset file ({display(path)})",
+                      allowed)
+
+
+def _present(data: dict, path: Tuple[str, ...]) -> bool:
+    for k in path:
+        if not isinstance(data, dict) or k not in data:
+            return False
+        data = data[k]
+    return True
 
 
 @dataclass
@@ -99,11 +131,27 @@ class Document:
             p = p[:-1]
         return self.label
 
+    def writer_of(self, key_path) -> str:
+        """The source that wrote exactly this key (a null or an empty ``--set`` counts: it
+        restored the default), else DEFAULT_SOURCE: the value is the schema's default."""
+        return self.origin.get(tuple(key_path), DEFAULT_SOURCE)
+
+    def missing_source(self, key_path) -> str:
+        """Whom to name for a required key that has no value: the file or ``--set KEY=``
+        whose null removed it (or an enclosing mapping), else this file."""
+        p = tuple(key_path)
+        while p and not _present(self.data, p):
+            if p in self.origin:
+                src = self.origin[p]
+                return f"{src} {'.'.join(p)}=" if src == SET_SOURCE else src
+            p = p[:-1]
+        return self.label
+
     def rank_of(self, key_path) -> int:
         return self.ranks.get(self.origin.get(tuple(key_path), ""), -1)
 
 
-def load(spec: str, source: str = "command line") -> Document:
+def load(spec: str, source: str = COMMAND_LINE) -> Document:
     """Load a preset by name or path, with its ``extends`` chain merged."""
     path = find(spec, source)
     data, origin, chain = _load_chain(path, [])

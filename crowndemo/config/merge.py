@@ -19,6 +19,9 @@ from typing import Dict, Tuple
 Path = Tuple[str, ...]
 Origin = Dict[Path, str]
 
+SET_SOURCE = "--set"            # the source of ``--set`` overrides
+DEFAULT_SOURCE = "default"      # the source of a value nobody wrote: the schema's default
+
 ALTERNATIVES = {("scene",): (("speed", "height"),)}
 ATOMIC = {("title",), ("description",)}
 
@@ -77,4 +80,4 @@ def _merge_into(data: dict, origin: Origin, over: dict, over_origin: Origin, pat
                 origin[p] = over_origin[p]
 
 
-__all__ = ["deep_merge", "origin_of", "ALTERNATIVES", "ATOMIC"]
+__all__ = ["deep_merge", "origin_of", "ALTERNATIVES", "ATOMIC", "SET_SOURCE", "DEFAULT_SOURCE"]

@@ -8,10 +8,10 @@ from typing import Iterable, List, Tuple
 
 from .errors import PresetError
 from .loader import Document
-from .merge import deep_merge, origin_of
+from .merge import SET_SOURCE, deep_merge, origin_of
 from .yamlio import parse_scalar
 
-SOURCE = "--set"
+SOURCE = SET_SOURCE
 _SEGMENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_-]*$")
 EXAMPLE = "KEY.PATH=VALUE, e.g. scene.speed=7.0 or quality.draft.l0=4e-4"
 
@@ -30,7 +30,7 @@ def parse(item: str) -> Tuple[Tuple[str, ...], object]:
     if parts[0] == "extends":
         raise PresetError(SOURCE, key, text, "extends cannot be changed with --set",
                           "write a preset file with extends: and name it instead")
-    value = parse_scalar(text, f"{SOURCE} {key}")
+    value = parse_scalar(text, f"{SOURCE} {key}", parts)
     return parts, value
 
 

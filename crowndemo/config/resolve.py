@@ -12,6 +12,7 @@ from ..core import timestep
 from ..core.params import Model, Numerics, ParameterError, Physics
 from .errors import MISSING, PresetError
 from .loader import Document
+from .merge import DEFAULT_SOURCE
 from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
 
 SPEED_MAX = 50.0        # m/s: beyond this the explicit step is not meant to serve
@@ -127,11 +128,12 @@ def resolve(doc: Document, quality: str) -> Resolved:
 
     def fail(name: str, value, why: str, allowed: str):
         key, source = where[name]
+        if source == DEFAULT_SOURCE:      # nobody set it: the fix goes into this file
+            source = doc.label
         raise PresetError(source, key, value, why, allowed)
 
     def note(name: str, path) -> None:
-        where[name] = (dotted(path), doc.source_of(path) if tuple(path) in doc.origin
-                       else doc.label)
+        where[name] = (dotted(path), doc.writer_of(path))
 
     rungs = values["quality"]
     if quality not in rungs:
@@ -140,7 +142,8 @@ def resolve(doc: Document, quality: str) -> Resolved:
                "this preset defines no such quality rung")
         allowed = (", ".join(defined) if defined else
                    "add quality: {draft: {l0: ...}} (rungs: " + ", ".join(QUALITIES) + ")")
-        raise PresetError(doc.label, f"quality.{quality}", MISSING, why, allowed)
+        raise PresetError(doc.missing_source(("quality", quality)), f"quality.{quality}",
+                          MISSING, why, allowed)
     rung = rungs[quality]
     rpath = ("quality", quality)
 
@@ -180,7 +183,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
         scene["speed"] = U
         where["speed"] = where["height"]
     elif "speed" not in scene:
-        raise PresetError(doc.label, "scene.speed", MISSING, "no impact speed: give "
+        raise PresetError(_speed_source(doc), "scene.speed", MISSING, "no impact speed: give "
                           "scene.speed [m/s] or scene.height [m]", SCENE_KEYS["speed"].allowed())
 
     # geometry
@@ -222,6 +225,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
         raise PresetError(doc.label, f"scene.liquid.{e.key}", e.value, "refused by the solver",
                           e.allowed) from None
     model = Model.of(physics, numerics)
+    _check_mach(scene, numerics, physics, fail)
 
     # the time step
     lim = timestep.limits(physics, numerics, model, scene["speed"])
@@ -255,6 +259,30 @@ def resolve(doc: Document, quality: str) -> Resolved:
         fail("numerics.fixed_dt", e.value, "breaks a time-step limit", e.allowed)
 
     return Resolved(doc, quality, values, dim, l0, scene, liquid, numerics, physics, model, where)
+
+
+def _speed_source(doc: Document) -> str:
+    """Whom to name when there is no impact speed: whoever removed speed or height."""
+    for key in ("speed", "height"):
+        source = doc.missing_source(("scene", key))
+        if source != doc.label:
+            return source
+    return doc.label
+
+
+def _check_mach(scene: dict, numerics: Numerics, physics: Physics, fail) -> None:
+    """The run stops as soon as a particle is faster than max_mach * c (core.health), and the
+    drop starts at U and gains speed as it falls: max_mach * c must exceed U."""
+    U, c, mach = scene["speed"], physics.c, numerics.max_mach
+    if mach * c > U:
+        return
+    why = (f"the run would stop at its first step: it stops when a particle is faster than "
+           f"numerics.max_mach * c = {mach:g} x {c:.4g} m/s, and the drop starts at "
+           f"U = {U:.4g} m/s")
+    if scene.get("sound_speed") is not None:
+        fail("sound_speed", c, why, f"> U / max_mach = {U / mach:.4g} m/s")
+    fail("numerics.max_mach", mach, why,
+         f"> U / c = {U / c:.4g} (c = 5 U unless scene.sound_speed is set)")
 
 
 __all__ = ["Resolved", "resolve", "SPEED_MAX", "DT_FLOOR", "MIN_ACROSS"]

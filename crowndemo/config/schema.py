@@ -112,7 +112,8 @@ SCENE_KEYS = {
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
                   default=True),
     "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
-    "sound_speed": number("artificial sound speed c (default 5 U, S8)", "m/s", 0, 1.0e5),
+    "sound_speed": number("artificial sound speed c (default 5 U, S8); above U / max_mach",
+                          "m/s", 0, 1.0e5),
 }
 
 _C = dict(lo=0, hi=2)
@@ -256,7 +257,7 @@ def _check_map(keys: Dict[str, Field], v: dict, path, doc: Document) -> dict:
         if k in v:
             out[k] = _check(f, v[k], p, doc)
         elif f.required:
-            raise PresetError(doc.label, dotted(p), MISSING, "no value given"
+            raise PresetError(doc.missing_source(p), dotted(p), MISSING, "no value given"
                               + (f" ({f.doc})" if f.doc else ""), f.allowed())
         elif f.default is not None:
             out[k] = _check(f, copy.deepcopy(f.default), p, doc)
