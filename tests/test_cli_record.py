@@ -1,5 +1,6 @@
 """The record/export/run command lines around recordings and sessions (in-process)."""
 import json
+import os
 
 import pytest
 
@@ -59,3 +60,54 @@ def test_run_then_reuses_the_session(capsys):
     assert second["startup"]["reused_simulator"] is True
     assert second["startup"]["kernels_compiled"] == 0
     assert first["steps"] == second["steps"] == 3
+
+
+def _files(folder):
+    """Every file under ``folder``: its bytes and modification time."""
+    return {p: (p.read_bytes(), p.stat().st_mtime_ns) for p in sorted(folder.rglob("*"))
+            if p.is_file()}
+
+
+def test_resume_of_a_complete_recording_touches_nothing(tmp_path, capsys, monkeypatch):
+    argv = ["record", "quick-2d", "--recordings", str(tmp_path), "--quiet"] + SHORT
+    assert main(argv) == 0
+    folder = tmp_path / "quick-2d"
+    before = _files(folder)
+    assert folder / "video.mp4" in before and folder / "metadata.json" in before
+    capsys.readouterr()
+
+    def no_backend(args):
+        raise AssertionError("Taichi started for a complete recording")
+    monkeypatch.setattr("crowndemo.cli.record.start_backend", no_backend)
+    assert main(argv + ["--resume"]) == 0
+    err = capsys.readouterr().err
+    assert "already complete" in err and "nothing to resume" in err
+    assert _files(folder) == before
+    # other values than the recording's: refused, still nothing touched
+    assert main(argv + ["--resume", "--set", "scene.speed=7"]) == 2
+    assert "speed" in capsys.readouterr().err and _files(folder) == before
+
+
+@pytest.mark.parametrize("where, words", [
+    ("afile", "afile: not a folder"),                       # a file
+    ("afile/sub", "afile: not a folder"),                   # under a file
+    ("rec", "quick-2d: not a folder"),                      # rec/quick-2d is a file
+    ("/proc/crowndemo-nope", "cannot create it"),           # a parent that takes no folders
+])
+def test_unusable_recordings_folder_exit_2_before_taichi(where, words, tmp_path, capsys,
+                                                          monkeypatch):
+    if where.startswith("/proc") and not os.path.isdir("/proc"):
+        pytest.skip("no /proc")
+    (tmp_path / "afile").touch()
+    (tmp_path / "rec").mkdir()
+    (tmp_path / "rec" / "quick-2d").touch()
+
+    def no_backend(args):
+        raise AssertionError("Taichi started before the folder was checked")
+    monkeypatch.setattr("crowndemo.cli.record.start_backend", no_backend)
+    folder = tmp_path / where
+    assert main(["record", "quick-2d", "--recordings", str(folder), "--max-steps", "1",
+                 "--no-render"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"crowndemo: error: --recordings {folder}: ") and words in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1

@@ -16,7 +16,10 @@ from crowndemo.control import Session
 from crowndemo.core.state import FLUID
 from crowndemo.interrupt import StopRequest
 from crowndemo.record import files, record_preset, snapshots
+from crowndemo.record import checkpoint as ckpt
 from crowndemo.record.checkpoint import load as load_checkpoint
+from crowndemo.record.checkpoint import save as save_checkpoint
+from crowndemo.record.runlog import RunLog
 
 T_END, INTERVAL = 1.0e-4, 2.5e-5
 SETS = [f"scene.t_end={T_END}", f"scene.frame_interval={INTERVAL}"]
@@ -63,6 +66,8 @@ def same_state(a, b):
     assert (sa.steps, sa.time, sa.dt_min, sa.dt_max) == (sb.steps, sb.time, sb.dt_min, sb.dt_max)
     assert list(sa.dt_log) == list(sb.dt_log) and list(sa.bound_log) == list(sb.bound_log)
     assert sa.binding == sb.binding and sa.health == sb.health
+    assert (sa.peak_max_speed, sa.peak_max_density_excess) == (sb.peak_max_speed,
+                                                               sb.peak_max_density_excess)
 
 
 def test_metadata_and_snapshots_of_a_complete_recording(uninterrupted, preset):
@@ -121,6 +126,40 @@ def test_ctrl_c_then_resume_is_bit_identical(uninterrupted, preset, tmp_path):
         b = snapshots.read(folder / f["file"])
         for k in snapshots.FIELDS:
             assert np.array_equal(a[k], b[k]), (f["file"], k)
+
+
+def test_checkpoint_keeps_every_run_statistic(uninterrupted, tmp_path):
+    state = uninterrupted[1]
+    assert state["stats"].peak_max_density_excess > state["stats"].health.max_density_excess
+    save_checkpoint(tmp_path / "c.npz", state, RunLog(), 5, {})
+    assert load_checkpoint(tmp_path / "c.npz").saved["stats"] == state["stats"]
+
+
+def test_older_checkpoint_peaks_come_from_its_run_log(uninterrupted):
+    stats = uninterrupted[1]["stats"]
+    d = ckpt._stats_json(stats)
+    del d["peak_max_speed"], d["peak_max_density_excess"]
+    old_log = {"peak_max_speed": 12.5, "peak_max_density_excess": 0.25}
+    back = ckpt._stats_from(d, np.asarray(stats.dt_log), np.asarray(stats.bound_log), old_log)
+    assert (back.peak_max_speed, back.peak_max_density_excess) == (12.5, 0.25)
+
+
+def test_resumed_run_reports_the_peaks_of_the_whole_run(uninterrupted, preset, tmp_path):
+    # measured: the density excess peaks at the impact, step 47 of 57; stop after it
+    full = uninterrupted[1]["stats"]
+    folder = tmp_path / "quick-2d"
+    first = record_preset(preset, folder, session=Session(), max_steps=50)
+    assert first.status == "interrupted"
+    assert first.sim.stats.peak_max_density_excess == full.peak_max_density_excess
+    resumed = record_preset(preset, folder, resume=True, session=Session())
+    assert resumed.complete and resumed.sim.stats.steps == full.steps
+    s = resumed.sim.stats
+    assert (s.peak_max_speed, s.peak_max_density_excess) == (full.peak_max_speed,
+                                                             full.peak_max_density_excess)
+    got = json.loads((folder / files.METADATA).read_text())["health"]
+    want = json.loads((uninterrupted[0].folder / files.METADATA).read_text())["health"]
+    for k in ("peak_max_speed_m_s", "peak_max_density_excess"):
+        assert got[k] == want[k], k
 
 
 def test_resume_refuses_other_parameters(uninterrupted, tmp_path):

@@ -36,7 +36,8 @@ renamed, so a file that exists is whole.
 
 Ctrl-C stops after the current step: the frames so far are kept, a checkpoint is saved,
 metadata.json says "interrupted", and the command prints how to resume (exit 130). A
-resumed run with --single-thread ends bit for bit where an uninterrupted one would.
+resumed run with --single-thread ends bit for bit where an uninterrupted one would; --resume
+of a complete recording says so and changes nothing (exit 0).
 An unstable run keeps its frames, marks metadata.json "unstable: ..." and exits 3.
 """
 
@@ -76,11 +77,44 @@ def _resume_command(r, args) -> str:
     return " ".join(shlex.quote(w) for w in words + ["--resume"])
 
 
+def _recordings_option(args) -> str:
+    """Where the recordings folder came from, to name it in an error."""
+    if args.recordings:
+        return "--recordings"
+    return "$CROWNDEMO_RECORDINGS" if os.environ.get("CROWNDEMO_RECORDINGS") else "recordings"
+
+
+def _check_folders(root: Path, names: List[str], args) -> None:
+    """UsageError, before Taichi starts, when a recording folder ROOT/NAME cannot be created
+    or written (ROOT a file, a parent that cannot hold folders, no permission)."""
+    from ..record import recording_dir
+    from ..record.files import folder_problem
+
+    for name in names:
+        bad = folder_problem(recording_dir(name, root))
+        if bad:
+            at, what = bad
+            where = "" if at == root else f"{at}: "
+            raise UsageError(f"{_recordings_option(args)} {root}: {where}{what}; allowed: a "
+                             "folder that exists or can be created, and can be written")
+
+
+def _resume_point(r, folder: Path, args):
+    """The checkpoint --resume continues from, checked before Taichi starts (the render sink,
+    made next, would remove the video of the recording)."""
+    from ..record import RecordError
+    from ..record.recorder import resume_point
+    try:
+        return resume_point(r, folder, args.precision)
+    except RecordError as e:
+        raise UsageError(str(e)) from None
+
+
 def _record(args) -> int:
     from ..control import Session
     from ..interrupt import StopRequest
     from ..record import RecordError, recording_dir, recordings_root
-    from ..record.recorder import record_preset
+    from ..record.recorder import AlreadyComplete, record_preset
 
     if args.max_steps is not None and args.max_steps < 1:
         raise ParameterError("max_steps", args.max_steps, "an integer >= 1", "command line")
@@ -96,6 +130,15 @@ def _record(args) -> int:
     if args.resume and len(resolved) > 1:
         raise UsageError("--resume takes one PRESET (no --then or --playlist)")
     root = Path(args.recordings) if args.recordings else recordings_root()
+    _check_folders(root, [r.name for r in resolved], args)
+    resume_from = None
+    if args.resume:
+        try:
+            resume_from = _resume_point(resolved[0], recording_dir(resolved[0].name, root), args)
+        except AlreadyComplete as e:          # nothing to do: say so, touch nothing
+            print(f"{PROG}: {e}", file=sys.stderr)
+            _dump([{"folder": str(e.folder), **e.meta}], args)
+            return 0
     be = start_backend(args)
     session = Session()
     stop = StopRequest(CTRL_C_NOTICE)
@@ -126,7 +169,8 @@ def _record(args) -> int:
                 res = record_preset(r, folder, render, args.resume,
                                     session=session, checkpoint_every=args.checkpoint_every,
                                     fluid_only=not args.all_particles, max_steps=args.max_steps,
-                                    on_step=progress, on_start=announce, stop=stop, backend=be)
+                                    on_step=progress, on_start=announce, stop=stop, backend=be,
+                                    resume_from=resume_from)
             except BaseException as e:
                 for sink in render:           # a run that never started: free the window
                     sink.release()

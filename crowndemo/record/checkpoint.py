@@ -1,18 +1,18 @@
 """Checkpoints: the full restartable state of a recording in one ``checkpoint.npz``.
 
 It holds every persistent particle field in storage order (exit reasons and parked particles
-included), the health counters, the run statistics with the dt and binding logs, the last
-health report (which sets the next dt), the run log (frames, peaks, wall times), the index of
-the next frame, and a fingerprint of the parameters, so that ``--resume`` refuses a checkpoint
-of other parameters. With ``Simulator.restore_state`` the resumed run takes the same steps as
-an uninterrupted one (bit for bit on one thread).
+included), the health counters, the run statistics (health peaks and wall time included) with
+the dt and binding logs, the last health report (which sets the next dt), the run log (frames,
+wall times, starts), the index of the next frame, and a fingerprint of the parameters, so
+that ``--resume`` refuses a checkpoint of other parameters. With ``Simulator.restore_state``
+the resumed run takes the same steps as an uninterrupted one (bit for bit on one thread).
 """
 from __future__ import annotations
 
 import json
 from array import array
 from collections import Counter
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Dict, List
 
@@ -47,17 +47,27 @@ class Checkpoint:
         return self.saved["stats"].steps
 
 
+# RunStats fields saved as they are; binding, the logs and the health report need converting
+_LOGS = ("binding", "dt_log", "bound_log", "health")
+_SCALARS = tuple(f.name for f in fields(RunStats) if f.name not in _LOGS)
+
+
 def _stats_json(s: RunStats) -> dict:
-    return {"steps": s.steps, "time": s.time, "dt_min": s.dt_min, "dt_max": s.dt_max,
-            "binding": dict(s.binding), "wall_seconds": s.wall_seconds,
-            "energy_start": s.energy_start, "health": asdict(s.health)}
+    d = {k: getattr(s, k) for k in _SCALARS}
+    d.update(binding=dict(s.binding), health=asdict(s.health))
+    return d
 
 
-def _stats_from(d: dict, dt_log: np.ndarray, bound_log: np.ndarray) -> RunStats:
-    return RunStats(steps=d["steps"], time=d["time"], dt_min=d["dt_min"], dt_max=d["dt_max"],
-                    binding=Counter(d["binding"]), dt_log=array("d", dt_log.tolist()),
-                    bound_log=array("B", bound_log.tolist()), wall_seconds=d["wall_seconds"],
-                    energy_start=d["energy_start"], health=HealthReport(**d["health"]))
+def _stats_from(d: dict, dt_log: np.ndarray, bound_log: np.ndarray, log: dict) -> RunStats:
+    """RunStats from ``_stats_json``. Checkpoints from before the peaks moved into RunStats
+    kept them in the run log; without either, the last health report is the best bound."""
+    h = HealthReport(**d["health"])
+    scalars = {k: d[k] for k in _SCALARS if k in d}
+    scalars.setdefault("peak_max_speed", log.get("peak_max_speed", h.max_speed))
+    scalars.setdefault("peak_max_density_excess",
+                       log.get("peak_max_density_excess", h.max_density_excess))
+    return RunStats(**scalars, binding=Counter(d["binding"]), health=h,
+                    dt_log=array("d", dt_log.tolist()), bound_log=array("B", bound_log.tolist()))
 
 
 def save(path: PathLike, saved: dict, log: RunLog, next_frame: int, fingerprint: dict) -> None:
@@ -85,7 +95,8 @@ def load(path: PathLike) -> Checkpoint:
                                       f"version reads format {FORMAT}")
             particles = {k.split("/", 1)[1]: z[k] for k in z.files if k.startswith("particles/")}
             saved = {"particles": particles, "health_counters": z["health_counters"],
-                     "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"]),
+                     "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"],
+                                           meta["log"]),
                      "n_fluid": meta["n_fluid"]}
     except (OSError, KeyError, ValueError) as e:
         if isinstance(e, CheckpointError):

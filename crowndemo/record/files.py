@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import json
 import os
+import tempfile
 from pathlib import Path
-from typing import BinaryIO, Callable, Union
+from typing import BinaryIO, Callable, Optional, Tuple, Union
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -21,6 +22,41 @@ def recordings_root() -> Path:
 
 def recording_dir(name: str, root: PathLike = None) -> Path:
     return Path(root if root is not None else recordings_root()) / name
+
+
+def folder_problem(folder: PathLike) -> Optional[Tuple[Path, str]]:
+    """Why recordings cannot be written into ``folder``, as (the path at fault, what is
+    wrong), or None when they can. Tried for real: the missing folders are created and a
+    temporary file written, then what was created is removed again."""
+    folder = Path(folder)
+    missing = []                      # deepest first
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        missing.append(existing)
+        existing = existing.parent
+    if not existing.is_dir():
+        return existing, "not a folder"
+    try:
+        return _try_writing(folder)
+    finally:
+        for p in missing:
+            try:
+                p.rmdir()
+            except OSError:
+                break
+
+
+def _try_writing(folder: Path) -> Optional[Tuple[Path, str]]:
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        return Path(e.filename or folder), f"cannot create it ({e.strerror})"
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as e:
+        return folder, f"cannot write in it ({e.strerror})"
+    return None
 
 
 def frame_name(index: int, suffix: str = ".npz") -> str:

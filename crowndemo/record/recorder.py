@@ -14,12 +14,24 @@ from . import checkpoint as ckpt
 from . import snapshots
 from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike
 from .metadata import MetadataSink, finite_or_none
+from .metadata import read as read_metadata
 from .runlog import RunLog
 from .sinks import COMPLETE, INTERRUPTED, unstable
 
 
 class RecordError(ValueError):
     """A recording that cannot be made or resumed as asked (one line, for the user)."""
+
+
+class AlreadyComplete(Exception):
+    """``--resume`` of a complete recording: nothing to resume, nothing is touched."""
+
+    def __init__(self, folder: Path, meta: dict):
+        frames = meta.get("frames") or []
+        super().__init__(f"{folder} is already complete ({len(frames)} frames to t = "
+                         f"{(meta.get('simulated_s') or 0.0) * 1e3:.4g} ms): nothing to "
+                         "resume, nothing changed; record without --resume to record it afresh")
+        self.folder, self.meta = folder, meta
 
 
 @dataclass
@@ -54,18 +66,57 @@ def fingerprint(resolved, precision: str) -> dict:
     return json.loads(json.dumps(finite_or_none(data)))
 
 
+def _other_parameters(path: Path, saved: dict, now: dict) -> None:
+    """RecordError naming the keys whose values differ, if any."""
+    diff = ckpt.differences(saved, now)
+    if diff:
+        raise RecordError(f"{path} was made with other parameters ("
+                          f"{'; '.join(diff[:4])}{'; ...' if len(diff) > 4 else ''}); "
+                          "resume with the same preset, --quality, --set and --precision, "
+                          "or record without --resume")
+
+
+def _metadata(path: Path) -> Optional[dict]:
+    """metadata.json, or None when it is missing or unreadable (the checkpoint decides)."""
+    try:
+        return read_metadata(path)
+    except (OSError, ValueError):
+        return None
+
+
+def resume_point(resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint:
+    """The checkpoint that ``--resume`` continues from, checked before anything runs or is
+    written: AlreadyComplete when metadata.json says the recording is complete; RecordError
+    when there is no checkpoint or either was made with other parameters."""
+    folder = Path(out_dir)
+    now = fingerprint(resolved, precision)
+    meta = _metadata(folder / METADATA)
+    if meta and meta.get("complete") is True:
+        _other_parameters(folder / METADATA, meta.get("fingerprint") or {}, now)
+        raise AlreadyComplete(folder, meta)
+    try:
+        saved = ckpt.load(folder / CHECKPOINT)
+    except ckpt.CheckpointError as e:
+        raise RecordError(f"{e}; record without --resume to start afresh") from None
+    _other_parameters(folder / CHECKPOINT, saved.fingerprint, now)
+    return saved
+
+
 def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resume: bool = False,
                   *, session=None, checkpoint_every: int = 1, fluid_only: bool = True,
                   max_steps: Optional[int] = None, on_step: Optional[Callable] = None,
                   on_start: Optional[Callable] = None, stop=None,
-                  backend=None) -> RecordResult:
+                  backend=None, resume_from: Optional[ckpt.Checkpoint] = None
+                  ) -> RecordResult:
     """Record ``resolved`` (a config.Resolved) into ``out_dir``; returns how it ended.
 
     ``sinks_extra`` are frame sinks called after the snapshot and before the checkpoint and
-    metadata. ``resume`` continues from ``out_dir/checkpoint.npz`` (RecordError if there is
-    none or it was made with other parameters). ``stop`` is an object whose ``requested``
-    turns true to stop after the current step (Ctrl-C); ``max_steps`` stops at that step
-    count (resumed steps included); both end "interrupted" with a checkpoint to resume from.
+    metadata. ``resume`` continues from ``out_dir/checkpoint.npz`` (``resume_from``: that
+    checkpoint, already loaded by ``resume_point``), raising what ``resume_point`` raises
+    (AlreadyComplete, RecordError) before anything is written. ``stop`` is an object whose
+    ``requested`` turns true to stop after the current step (Ctrl-C); ``max_steps`` stops at
+    that step count (resumed steps included); both end "interrupted" with a checkpoint to
+    resume from.
     An InstabilityError ends "unstable: ..." (returned in ``error``, not raised); frames
     written so far are kept. ``on_step(sim)`` runs after every step (progress), ``on_start(
     result)`` once the simulator is loaded.
@@ -81,16 +132,7 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     saved = None
     replaced = 0
     if resume:
-        try:
-            saved = ckpt.load(folder / CHECKPOINT)
-        except ckpt.CheckpointError as e:
-            raise RecordError(f"{e}; record without --resume to start afresh") from None
-        diff = ckpt.differences(saved.fingerprint, print_)
-        if diff:
-            raise RecordError(f"{folder / CHECKPOINT} was made with other parameters ("
-                              f"{'; '.join(diff[:4])}{'; ...' if len(diff) > 4 else ''}); "
-                              "resume with the same preset, --quality, --set and --precision, "
-                              "or record without --resume")
+        saved = resume_from or resume_point(resolved, folder, be.precision)
         snapshots.remove_from(folder / SNAPSHOTS, saved.next_frame)   # re-made from here
     else:
         replaced = snapshots.remove_from(folder / SNAPSHOTS, 0)
@@ -153,4 +195,5 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     return result
 
 
-__all__ = ["record_preset", "RecordResult", "RecordError", "fingerprint", "frame_times"]
+__all__ = ["record_preset", "resume_point", "RecordResult", "RecordError", "AlreadyComplete",
+           "fingerprint", "frame_times"]
