@@ -162,6 +162,18 @@ def test_resumed_run_reports_the_peaks_of_the_whole_run(uninterrupted, preset, t
         assert got[k] == want[k], k
 
 
+def test_a_frame_sees_the_wall_time_so_far(preset):
+    """The checkpoint written at a frame holds the stepping wall time up to that frame (it held
+    the time of earlier runs only, so a run killed and resumed from it under-counted)."""
+    from crowndemo.core import simulator_for
+    sim = simulator_for(preset.build_scene())
+    frames = [0.0, 2 * INTERVAL, T_END]
+    seen = []
+    stats = sim.run(T_END, frames, on_frame=lambda s, i: seen.append(s.stats.wall_seconds))
+    assert len(seen) == 3 and seen[0] < seen[1] < seen[2]
+    assert seen[1] > 0.0 and seen[2] == pytest.approx(stats.wall_seconds, rel=0.05)
+
+
 def test_resume_refuses_other_parameters(uninterrupted, tmp_path):
     from crowndemo.record import RecordError
     other = config.load("quick-2d", "draft", SETS + ["scene.speed=6"])

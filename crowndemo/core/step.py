@@ -286,6 +286,10 @@ class Simulator:
             while True:
                 while fi < len(frames) and frames[fi] <= self.stats.time + eps:
                     if on_frame:
+                        # the wall time so far, for what on_frame saves (a checkpoint)
+                        now = _time.perf_counter()
+                        self.stats.wall_seconds += now - start
+                        start = now
                         on_frame(self, fi)
                     fi += 1
                 if self.stats.time >= t_end - eps:
