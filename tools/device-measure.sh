@@ -5,6 +5,9 @@
 #
 #   tools/device-measure.sh PHASE [PHASE ...]
 #
+# The phases named share one call's time: each command is stopped at CALL_SECONDS (540) from
+# the start, so that what it wrote comes back before the device tool's 600 s limit.
+#
 #   check       the CUDA step against the CPU's, the block reductions and the size limit
 #               (tests/test_gpu_arch.py, test_blocks.py, test_field_limit.py)
 #   throughput  the tank block at 1 M and 12 M fluid particles (target: 5e8 particle-steps/s)
@@ -16,7 +19,7 @@
 # which the call carries; they are installed into /tmp/site. Every bench run appends its section
 # to BENCHMARKS.md (--record); each phase's log and BENCHMARKS.md are copied into $OUT, which the
 # device tool brings back. Settings: ARCH (default cuda), TANK_N, PRESET, QUALITY, VARIANT_N,
-# STEPS; DRY_RUN=1 prints the commands instead of running them (tests/test_device_script.py).
+# STEPS, CALL_SECONDS; DRY_RUN=1 prints the commands instead of running them (tests/test_device_script.py).
 set -uo pipefail
 cd "$(dirname "$0")/.."
 
@@ -27,7 +30,7 @@ QUALITY=${QUALITY:-seed}
 VARIANT_N=${VARIANT_N:-12000000}
 STEPS=${STEPS:-50}
 OUT=${OUT:-/tmp/device-measure}
-PHASE_SECONDS=${PHASE_SECONDS:-540}   # a phase's commands stop here, inside the call's 600 s
+CALL_SECONDS=${CALL_SECONDS:-540}     # every command stops by then: inside a call's 600 s
 DRY_RUN=${DRY_RUN:-0}
 PHASES="check throughput seed variants"
 
@@ -47,19 +50,21 @@ if [ "$DRY_RUN" != 1 ] && ! python3 -c "import taichi" 2>/dev/null; then
   export PYTHONPATH="/tmp/site:$PYTHONPATH"
 fi
 
-started=$(date +%s)
+started=$(date +%s)        # the phases share one call's time
 status=0
 
-# run LOG CMD...: print the command, run it (unless DRY_RUN) into $OUT/LOG.log under the phase's
-# time limit, and remember a failure
+# run LOG CMD...: print the command, run it (unless DRY_RUN) into $OUT/LOG.log within the
+# call's time, and remember a failure; BENCHMARKS.md is copied after each, so what a command
+# recorded comes back even if a later one is killed at the call's limit
 run() {
   local log=$1; shift
   echo "+ $*" | tee -a "$OUT/$log.log"
   [ "$DRY_RUN" = 1 ] && return 0
-  local left=$(( PHASE_SECONDS - ($(date +%s) - started) ))
-  if [ "$left" -le 10 ]; then echo "skipped: the phase's time is spent" | tee -a "$OUT/$log.log"; status=1; return 1; fi
+  local left=$(( CALL_SECONDS - ($(date +%s) - started) ))
+  if [ "$left" -le 10 ]; then echo "skipped: the call's time is spent" | tee -a "$OUT/$log.log"; status=1; return 1; fi
   timeout "$left" "$@" 2>&1 | tee -a "$OUT/$log.log"
   local rc=${PIPESTATUS[0]}
+  cp BENCHMARKS.md "$OUT/" 2>/dev/null
   [ "$rc" = 0 ] || { echo "exit status $rc" | tee -a "$OUT/$log.log"; status=1; }
   return "$rc"
 }
@@ -86,7 +91,6 @@ finish() {
 trap finish EXIT
 
 for phase in "$@"; do
-  started=$(date +%s)
   case $phase in
     check)
       run check python3 -m pytest -q -p no:cacheprovider -n 3 --dist loadfile \
