@@ -21,11 +21,14 @@ MARTIN_MOYCE = [(0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995)]
                                                 (3, 2.0e-3, 0.024, 0.06)])
 def test_hydrostatic_tank(dim, l0, width, depth):
     # A viscosity of 1e-3 m^2/s damps the start-up acoustic waves; the hydrostatic answer does
-    # not depend on it.
+    # not depend on it. The column started at zero pressure still breathes by a few per cent
+    # at 0.25 s, so the profile is averaged over 0.15-0.3 s (as validate's hydrostatic case).
     scene = hydrostatic_tank(dim=dim, l0=l0, width=width, depth=depth, nu=1.0e-3)
     sim = simulator_for(scene)
-    sim.run(0.25)
-    k, p_floor = fluid_pressure_profile(sim, width, depth, l0)
+    fits = []
+    sim.run(0.3, frame_times=np.linspace(0.15, 0.3, 7),
+            on_frame=lambda s, i: fits.append(fluid_pressure_profile(s, width, depth, l0)))
+    k, p_floor = np.mean(fits, axis=0)
     assert p_floor == pytest.approx(RHO * G * depth, rel=0.05)       # P(0) = rho g H
     assert k == pytest.approx(RHO * G, rel=0.05)                      # dP/dz = -rho g
     h = sim.stats.health
