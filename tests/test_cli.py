@@ -47,6 +47,7 @@ def test_info_table(capsys):
     (["info", "--dim", "3", "--l0", "nan"], "l0"),
     (["info", "--dim", "3"], "--l0"),
     (["info", "--dim", "3", "--l0", "x"], "--l0"),
+    (["info", "--dim", "3", "--l0", "1e-4", "--sound-speed", "1e-3"], "--sound-speed"),
     (["scene", "dam-break", "--dim", "2", "--a", "-0.1"], "a"),
     (["scene", "tank", "--a", "0.1"], "--a"),
     (["bench", "--n", "0"], "n"),
@@ -61,6 +62,8 @@ def test_info_table(capsys):
     (["presets", "--rate", "0"], "--rate"),
     (["presets", "--rate", "-1"], "--rate"),
     (["scene", "tank", "--dim", "3", "--l0", "1e-5"], "--l0"),
+    (["scene", "tank", "--l0", "0.04", "--t-end", "0.01"], "--width"),
+    (["scene", "patch", "--side", "1e-4"], "--side"),
     (["scene", "dam-break", "--dim", "2", "--l0", "2e-6"], "--l0"),
     (["nosuch"], "nosuch"),
 ])
@@ -203,3 +206,17 @@ def test_a_closed_stdout_ends_quietly():
     err = proc.stderr.read().decode()
     assert proc.wait() == 141, err
     assert "Traceback" not in err and "BrokenPipe" not in err
+
+
+def test_json_is_strict_when_no_step_sets_a_dt_range(capsys):
+    """A run whose only step is cut short to land on its end has no dt range: null, not
+    Infinity (which JSON lacks), and the text summary says why."""
+    import json
+
+    def no_constants(name):
+        raise AssertionError(f"non-standard JSON constant {name}")
+    assert main(["scene", "dam-break", "--t-end", "1e-9", "--json", "--quiet"]) == 0
+    data = json.loads(capsys.readouterr().out, parse_constant=no_constants)
+    assert data["steps"] == 1 and data["dt_min_s"] is None and data["dt_max_s"] is None
+    assert main(["scene", "dam-break", "--t-end", "1e-9", "--quiet"]) == 0
+    assert "every step cut short to land on a frame time or the end" in capsys.readouterr().out

@@ -7,6 +7,7 @@ User mistakes (bad flags, parameters out of range, an unavailable arch) print on
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -147,6 +148,13 @@ def clock(seconds: float) -> str:
     return f"{s // 60}:{s % 60:02d}"
 
 
+def json_text(data) -> str:
+    """Strict JSON of a result: NaN and infinities (which JSON lacks) as null, numpy numbers
+    as numbers."""
+    from ..record.metadata import finite_or_none
+    return json.dumps(finite_or_none(json.loads(json.dumps(data, default=float))), indent=2)
+
+
 def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:
     """The JSON part shared by `scene` and `run`: stats, health with peaks, particles."""
     d = run["stats"].as_dict()
@@ -167,8 +175,10 @@ def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: flo
     print(f"  particles   {fmt_counts(counts)}")
     early = {"max-steps": " (stopped early: --max-steps)", "ctrl-c": " (interrupted: Ctrl-C)"
              }.get(run.get("stopped_by"), "")
-    print(f"  simulated   {stats.time * 1e3:.4g} ms in {stats.steps:,} steps{early}; dt "
-          f"{stats.dt_min:.3g} .. {stats.dt_max:.3g} s; steps bound by: {binding}")
+    dts = (f"dt {stats.dt_min:.3g} .. {stats.dt_max:.3g} s" if stats.dt_max > 0 else
+           "every step cut short to land on a frame time or the end")
+    print(f"  simulated   {stats.time * 1e3:.4g} ms in {stats.steps:,} steps{early}; {dts}; "
+          f"steps bound by: {binding}")
     print(f"  health      max speed {h.max_speed:.4g} m/s (peak {peak['speed']:.4g}, "
           f"c = {sound_speed:.4g}); max density excess n/n0 - 1 = "
           f"{h.max_density_excess:.4g} (peak {peak['excess']:.4g})")

@@ -2,12 +2,11 @@
 time-step limits of a lattice; pure host computation."""
 from __future__ import annotations
 
-import json
 import math
 from typing import Dict
 
 from ..config import DEFAULT_QUALITY, QUALITIES
-from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, load_preset)
+from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, json_text, load_preset)
 
 
 INFO_EPILOG = """\
@@ -55,12 +54,18 @@ def _info(args) -> int:
 def _info_lattice(args) -> int:
     from ..core import timestep
     from ..core.lattice import LatticeConstants
-    from ..core.params import Model, Numerics, Physics
+    from ..core.params import Model, Numerics, ParameterError, Physics
 
     physics = Physics(dim=args.dim, l0=args.l0, v_max=args.speed, re_ratio=args.re_ratio,
                       rho=args.rho, nu=args.nu, sigma=args.sigma,
                       sound_speed=args.sound_speed).validate("info")
     numerics = Numerics()
+    if numerics.max_mach * physics.c <= physics.v_max:
+        # a run stops at once when a particle outruns max_mach * c (core/health.py)
+        raise ParameterError("sound_speed", physics.c,
+                             f"> speed / max_mach = {physics.v_max / numerics.max_mach:.4g} m/s "
+                             f"(a run stops when a particle is faster than max_mach * c, "
+                             f"max_mach = {numerics.max_mach:g})", "info")
     model = Model.of(physics, numerics)
     lat = LatticeConstants.compute(physics.dim, physics.l0, physics.re_ratio, physics.rho,
                                    physics.sigma)
@@ -81,7 +86,7 @@ def _info_lattice(args) -> int:
            "limits_s": all_limits, "safety": safety, "dt_s": dt, "binding": binding,
            "binding_ties": ties, "model": Model.describe(model)}
     if args.json:
-        print(json.dumps(out, indent=2))
+        print(json_text(out))
         return 0
 
     def lim_line(name, rule):
@@ -196,7 +201,7 @@ def _info_preset(args) -> int:
     tp = estimate.throughput()
     f = _preset_facts(r, tp)
     if args.json:
-        print(json.dumps(f, indent=2, default=float))
+        print(json_text(f))
         return 0
     s, liq, p = f["scene"], f["liquid"], f["particles"]
     src = {k: v["key"] for k, v in f["sources"].items()}

@@ -1,14 +1,13 @@
 """``crowndemo run``: simulate presets one after another in one session and summarise each."""
 from __future__ import annotations
 
-import json
 import sys
 import time
 
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
 from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, add_sequence_options,
-                     load_presets, print_summary, run_result, simulate, start_backend)
+                     json_text, load_presets, print_summary, run_result, simulate, start_backend)
 
 
 RUN_EPILOG = """\
@@ -100,7 +99,7 @@ def _run(args) -> int:
                       file=sys.stderr)
                 break
     if args.json:
-        print(json.dumps(results[0] if len(results) == 1 else results, indent=2, default=float))
+        print(json_text(results[0] if len(results) == 1 else results))
     elif len(results) > 1:
         print(f"{len(results)} runs in {time.perf_counter() - t_all:.2f} s")
     return 130 if stop.requested else 0

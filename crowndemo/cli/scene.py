@@ -2,14 +2,14 @@
 each is checked against (method.md §7)."""
 from __future__ import annotations
 
-import json
 import math
 import sys
 import time
 from typing import Dict
 
 from ..core.params import GRADIENT_FORMS, Numerics, ParameterError
-from .common import (NUMERICS, PROG, Fmt, print_summary, run_result, simulate, start_backend)
+from .common import (NUMERICS, PROG, Fmt, json_text, print_summary, run_result, simulate,
+                     start_backend)
 
 
 # per scene, by dimension: the defaults of its options (keys are the builders' keywords)
@@ -44,6 +44,9 @@ A progress line (simulated time, steps/s) goes to stderr every ~2 s; the summary
 An unstable run stops with exit status 3 and says what broke; lower the safety numbers
 (e.g. --acoustic 0.5 --courant 0.1, half the seed's time step) or try another --gradient.
 """
+
+
+ACROSS_MIN = 4          # particles across every size of a reference scene, at least
 
 
 def _positive(key: str, value: float, unit: str) -> None:
@@ -88,8 +91,11 @@ def _values(name: str, args, numerics: Numerics) -> Dict:
     for k in ("width", "depth", "a", "side"):
         if k in val:
             _positive(k, val[k], "m")
-            if val[k] < val["l0"]:
-                raise ParameterError(k, val[k], f">= l0 = {val['l0']:g} m", "command line")
+            # the reference figure needs a body, not a handful of particles
+            if val[k] < ACROSS_MIN * val["l0"]:
+                raise ParameterError(k, val[k], f">= {ACROSS_MIN} l0 = "
+                                     f"{ACROSS_MIN * val['l0']:g} m ({ACROSS_MIN} particles "
+                                     "across at least)", "command line")
     model = Model(args.dim, False, False, False, numerics.pressure_gradient,
                   numerics.collision > 0, numerics.neighbour_list)
     limit = max_particles(model)
@@ -195,7 +201,7 @@ def _scene(args) -> int:
               "resolved_arch": be.resolved, "precision": be.precision,
               **run_result(run, counts, setup_s), "observables": obs}
     if args.json:
-        print(json.dumps(result, indent=2, default=float))
+        print(json_text(result))
         return 0
     size = ", ".join(f"{k} {v:g}" for k, v in val.items() if k not in ("l0", "t_end"))
     head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {size}; gradient "

@@ -57,8 +57,10 @@ class RunStats:
 
     def as_dict(self) -> dict:
         h = self.health
-        return {"steps": self.steps, "time_s": self.time, "dt_min_s": self.dt_min,
-                "dt_max_s": self.dt_max, "binding_limits": dict(self.binding),
+        regular = self.dt_max > 0      # a step not cut short to land on a frame
+        return {"steps": self.steps, "time_s": self.time,
+                "dt_min_s": self.dt_min if regular else None,
+                "dt_max_s": self.dt_max if regular else None, "binding_limits": dict(self.binding),
                 "wall_seconds": self.wall_seconds,
                 "health": {"max_speed_m_s": h.max_speed,
                            "max_density_excess": h.max_density_excess,
