@@ -111,3 +111,48 @@ def test_unusable_recordings_folder_exit_2_before_taichi(where, words, tmp_path,
     err = capsys.readouterr().err
     assert err.startswith(f"crowndemo: error: --recordings {folder}: ") and words in err
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_max_steps_stops_each_preset_of_a_chain(tmp_path, capsys):
+    """Like run: every preset of --then / --playlist is recorded, each stopped at step N and
+    marked so (resumable), exit 0."""
+    (tmp_path / "q2.yaml").write_text("extends: quick-2d\n")
+    (tmp_path / "list.txt").write_text(f"{tmp_path / 'q3.yaml'}\n")
+    (tmp_path / "q3.yaml").write_text("extends: quick-2d\n")
+    rec = tmp_path / "rec"
+    assert main(["record", "quick-2d", "--then", str(tmp_path / "q2.yaml"), "--playlist",
+                 str(tmp_path / "list.txt"), "--max-steps", "3", "--no-render", "--quiet",
+                 "--json", "--recordings", str(rec)] + SHORT) == 0
+    out, err = capsys.readouterr()
+    metas = json.loads(out)
+    assert [m["preset"] for m in metas] == ["quick-2d", "q2", "q3"]
+    for m in metas:
+        meta = json.loads((rec / m["preset"] / "metadata.json").read_text())
+        assert (meta["status"], meta["stopped_by"], meta["steps"]) == ("interrupted",
+                                                                      "max-steps", 3)
+        assert (rec / m["preset"] / "checkpoint.npz").is_file()
+    assert err.count("interrupted (max-steps)") == 3 and "Traceback" not in err
+
+
+def test_encoding_failure_marks_the_recording_failed(tmp_path, capsys, monkeypatch):
+    """A video that cannot be made: one error line, exit 1, metadata.json "failed: ...",
+    only partial names; the presets after it are not recorded (as after an unstable one)."""
+    from crowndemo.render import video
+
+    def broken(*args, **kw):
+        raise OverflowError("int too big to convert")
+    monkeypatch.setattr(video, "encode_gif", broken)
+    (tmp_path / "q2.yaml").write_text("extends: quick-2d\n")
+    rec = tmp_path / "rec"
+    assert main(["record", "quick-2d", "--then", str(tmp_path / "q2.yaml"), "--recordings",
+                 str(rec), "--resolution", "160x90", "--quiet"] + SHORT) == 1
+    err = capsys.readouterr().err
+    assert err.startswith("crowndemo: error: making the video failed (OverflowError: ")
+    assert "not recorded: q2" in err and len(err.strip().splitlines()) == 1
+    folder = rec / "quick-2d"
+    meta = json.loads((folder / "metadata.json").read_text())
+    assert meta["complete"] is False and meta["status"].startswith("failed: OverflowError")
+    assert meta["render"]["outputs"] == {"video": "video.partial.mp4"}
+    names = {p.name for p in folder.iterdir()}
+    assert "video.partial.mp4" in names and not names & {"video.mp4", "preview.gif"}
+    assert not (rec / "q2").exists()

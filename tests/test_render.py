@@ -207,3 +207,42 @@ def test_render_options_and_sink_from_args(tmp_path):
         p.parse_args(["--resolution", "640by360"])
     r = config.load("quick", "draft")
     assert sink_from_args(p.parse_args(["--no-render"]), r, tmp_path) is None
+
+
+def test_sink_whose_encoding_fails_leaves_only_partial_names(renderer, tmp_path, monkeypatch):
+    """The video is made, the preview fails: close raises, and the video takes the partial
+    name, so nothing stands as complete."""
+    from crowndemo.render import video
+    r = config.load("quick-2d", "draft")
+    out = tmp_path / "rec"
+    sink = FrameSink(str(out), PresetView.from_resolved(r, RenderSettings(resolution=RES)),
+                     renderer)
+    for i in range(3):
+        video.write_png(np.full((RES[1], RES[0], 3), 40 * i, np.uint8),
+                        str(out / "frames" / f"frame_{i:05d}.png"))
+
+    def broken(*args, **kw):
+        raise OverflowError("int too big to convert")
+    monkeypatch.setattr(video, "encode_gif", broken)
+    with pytest.raises(OverflowError):
+        sink.close("complete")
+    assert sorted(p.name for p in out.iterdir()) == ["frames", "video.partial.mp4"]
+    assert sink.outputs == {"video": str(out / "video.partial.mp4")}
+    assert len(list(video.read_video(str(out / "video.partial.mp4")))) == 3
+
+
+def test_gif_delay_fits_its_16_bits(tmp_path):
+    """At the slowest --fps, many frames per preview frame (and identical frames, which
+    Pillow merges, adding their delays) still make a GIF."""
+    from PIL import Image
+
+    from crowndemo.render.video import encode_gif, write_png
+    paths = []
+    for i in range(2):
+        paths.append(str(tmp_path / f"f{i}.png"))
+        write_png(np.full((8, 8, 3), 200 * i, np.uint8), paths[-1])
+    out = tmp_path / "p.gif"
+    assert encode_gif(paths[:1] * 1600 + paths[1:] * 1600, str(out), 0.1) == 24
+    with Image.open(out) as im:
+        assert im.info["duration"] > 0
+    assert sorted(os.listdir(tmp_path)) == ["f0.png", "f1.png", "p.gif"]

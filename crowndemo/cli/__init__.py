@@ -39,8 +39,9 @@ examples:
   crowndemo bench --n 100000 --steps 20          # particle-steps per second
 
 Run 'crowndemo COMMAND --help' for the options of a command.
-Exit status: 0 ok, 2 a usage or parameter error, 3 the simulation became unstable,
-130 interrupted (Ctrl-C), 141 stdout closed early (a pipe into head).
+Exit status: 0 ok, 1 a recording's video could not be made or a validation check failed,
+2 a usage or parameter error, 3 the simulation became unstable, 130 interrupted (Ctrl-C),
+141 stdout closed early (a pipe into head).
 """
 
 

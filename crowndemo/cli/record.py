@@ -7,7 +7,7 @@ import os
 import shlex
 import sys
 from pathlib import Path
-from typing import List
+from typing import List, Optional
 
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
@@ -39,7 +39,12 @@ metadata.json says "interrupted", and the command prints how to resume (exit 130
 resumed run with --single-thread ends bit for bit where an uninterrupted one would; --resume
 of a complete recording says so and changes nothing (exit 0).
 An unstable run keeps its frames, marks metadata.json "unstable: ..." and exits 3.
+--max-steps stops every preset of --then and --playlist at step N (each resumable).
+When the video cannot be made, its files get the .partial names, metadata.json says
+"failed: ..." and the command exits 1.
 """
+
+EXIT_FAILED = 1      # the recording failed otherwise (the video could not be made)
 
 
 def extra_sinks(resolved, folder: Path, args) -> List:
@@ -197,20 +202,36 @@ def _record(args) -> int:
                       f"a frame against {t['simulation_seconds_per_frame']:.2f} s of simulation "
                       f"a frame; video and preview {t['encode_seconds']:.1f} s: "
                       f"{', '.join(os.path.basename(v) for v in t['outputs'].values()) or 'none'}")
-            if res.status.startswith("unstable"):
-                print(f"{PROG}: {res.error}", file=sys.stderr)
-                print(f"{PROG}: kept {len(res.log.frames)} frames in {folder}", file=sys.stderr)
+            code = _ending(r, res, folder, args, [x.name for x in resolved[i + 1:]])
+            if code is not None:
                 _dump(out, args)
-                return 3
-            if not res.complete:
-                t, k = res.sim.stats.time, res.sim.stats.steps
-                print(f"{PROG}: interrupted ({res.log.stopped_by}) at t = {t * 1e3:.4g} ms, step "
-                      f"{k:,}; kept {len(res.log.frames)} frames in {folder}; to resume: "
-                      f"{_resume_command(r, args)}", file=sys.stderr)
-                _dump(out, args)
-                return 130 if res.log.stopped_by == "ctrl-c" else 0
+                return code
     _dump(out, args)
     return 0
+
+
+def _ending(r, res, folder: Path, args, left: List[str]) -> Optional[int]:
+    """Say how a recording that did not complete ended; the exit status when the presets
+    after it (``left``) are not to be recorded, None to go on (--max-steps stops each)."""
+    kept = f"kept {len(res.log.frames)} frames in {folder}"
+    not_recorded = f"; not recorded: {', '.join(left)}" if left else ""
+    if res.close_error is not None:
+        e = res.close_error
+        print(f"{PROG}: error: making the video failed ({type(e).__name__}: {e}); {kept}, "
+              f"metadata.json says {res.status.split(':')[0]!r}{not_recorded}", file=sys.stderr)
+        return EXIT_FAILED
+    if res.status.startswith("unstable"):
+        print(f"{PROG}: {res.error}", file=sys.stderr)
+        print(f"{PROG}: {kept}{not_recorded}", file=sys.stderr)
+        return 3
+    if res.complete:
+        return None
+    t, k = res.sim.stats.time, res.sim.stats.steps
+    ctrl_c = res.log.stopped_by == "ctrl-c"
+    print(f"{PROG}: interrupted ({res.log.stopped_by}) at t = {t * 1e3:.4g} ms, step {k:,}; "
+          f"{kept}; to resume: {_resume_command(r, args)}" + (not_recorded if ctrl_c else ""),
+          file=sys.stderr)
+    return 130 if ctrl_c else None
 
 
 def _add_render_timing(folder: Path, meta: dict, sink, res) -> dict:
@@ -258,8 +279,8 @@ def register(sub, common) -> None:
     p.add_argument("--all-particles", action="store_true",
                    help="snapshots with wall and dummy particles too (default: fluid only)")
     p.add_argument("--max-steps", type=int, metavar="N",
-                   help="stop at step N (counted from t = 0) as if interrupted: a checkpoint "
-                        "is saved and --resume continues (exit 0)")
+                   help="stop each preset at step N (counted from t = 0) as if interrupted: "
+                        "a checkpoint is saved and --resume continues (exit 0)")
     p.add_argument("--json", action="store_true",
                    help="print metadata.json (a list with several presets)")
     from ..render import add_render_options

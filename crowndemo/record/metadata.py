@@ -1,8 +1,9 @@
 """``metadata.json``: what a recording is and how far it got.
 
 Written (atomically) when the run starts with ``complete: false, status: "running"``, again at
-every frame, and at the end with the final status: "complete", "interrupted" or
-"unstable: <message>". A run killed outright therefore leaves ``complete: false``.
+every frame, and at the end with the final status: "complete", "interrupted",
+"unstable: <message>" or "failed: <error>" (an error, e.g. while encoding the video). A run
+killed outright therefore leaves ``complete: false``.
 """
 from __future__ import annotations
 

@@ -46,6 +46,7 @@ class RecordResult:
     resumed: Optional[ckpt.Checkpoint] = None
     error: Optional[BaseException] = None
     replaced_frames: int = 0        # frames of an earlier recording removed at the start
+    close_error: Optional[BaseException] = None   # a sink that failed to close (encoding)
 
     @property
     def complete(self) -> bool:
@@ -102,6 +103,28 @@ def resume_point(resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint
     return saved
 
 
+def failed(e: BaseException) -> str:
+    """The status of a recording that an error ended."""
+    return f"failed: {type(e).__name__}: {e}"
+
+
+def _close(sinks: Sequence, status: str, result: RecordResult) -> str:
+    """Close every sink with ``status``; returns the final status. A sink whose close fails
+    (the video encoder) is kept in ``result.close_error``; a run that had completed then
+    ends "failed: ..." (Ctrl-C: "interrupted") for the sinks after it, metadata.json last,
+    so a recording is never left "running" or marked complete without its files."""
+    for sink in sinks:
+        try:
+            sink.close(status)
+        except (Exception, KeyboardInterrupt) as e:
+            result.close_error = result.close_error or e
+            if status == COMPLETE and isinstance(e, KeyboardInterrupt):
+                status, result.log.stopped_by = INTERRUPTED, "ctrl-c (at once)"
+            elif status == COMPLETE:
+                status = failed(e)
+    return status
+
+
 def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resume: bool = False,
                   *, session=None, checkpoint_every: int = 1, fluid_only: bool = True,
                   max_steps: Optional[int] = None, on_step: Optional[Callable] = None,
@@ -118,8 +141,10 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     that step count (resumed steps included); both end "interrupted" with a checkpoint to
     resume from.
     An InstabilityError ends "unstable: ..." (returned in ``error``, not raised); frames
-    written so far are kept. ``on_step(sim)`` runs after every step (progress), ``on_start(
-    result)`` once the simulator is loaded.
+    written so far are kept. A sink that fails to close (the video encoder) is returned in
+    ``close_error``, not raised (Ctrl-C is, once every sink is closed); a run that had
+    completed then ends "failed: ...". ``on_step(sim)`` runs after every step (progress),
+    ``on_start(result)`` once the simulator is loaded.
     """
     from .. import backend as backend_mod
     from ..control import Session
@@ -184,14 +209,14 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
         status, log.stopped_by, result.error = INTERRUPTED, "ctrl-c (at once)", e
         closing = [k for k in sinks if k is not checkpoint]
     except Exception as e:
-        status, result.error = f"failed: {type(e).__name__}: {e}", e
+        status, result.error = failed(e), e
         closing = [k for k in sinks if k is not checkpoint]
-    result.status = status
-    for sink in closing:
-        sink.close(status)
+    result.status = _close(closing, status, result)
     if isinstance(result.error, (KeyboardInterrupt, Exception)) and not isinstance(
             result.error, InstabilityError):
         raise result.error
+    if isinstance(result.close_error, KeyboardInterrupt):
+        raise result.close_error
     return result
 
 

@@ -4,8 +4,9 @@ lines."""
 from __future__ import annotations
 
 import argparse
+import math
 import os
-from typing import Tuple
+from typing import Callable, Tuple
 
 from .captions import LANGS
 from .colours import DEFAULT_MODE, MODES
@@ -27,14 +28,27 @@ def parse_resolution(text: str) -> Tuple[int, int]:
     return w, h
 
 
-def positive(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"{text!r}: must be > 0")
-    return value
+# --fps: 0.1 (a frame every 10 s, a slideshow) to 240 (the fastest common display rate);
+# outside it ffmpeg's frame-rate ratio and the GIF's 16-bit frame delay overflow, and only
+# after the whole simulation, when the video is made.
+FPS_RANGE = (0.1, 240.0)
+# --orbit: degrees per frame, either way; a bigger turn looks the same as a smaller one the
+# other way, and a non-finite one puts the camera nowhere (blank frames).
+ORBIT_RANGE = (-180.0, 180.0)
+
+
+def bounded(lo: float, hi: float, unit: str) -> Callable[[str], float]:
+    """An argparse type: a finite number in ``lo..hi`` (``unit`` names it in the error)."""
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not lo <= value <= hi:          # NaN fails every comparison
+            raise argparse.ArgumentTypeError(f"{text!r}: allowed: a number from {lo:g} to "
+                                             f"{hi:g} ({unit})")
+        return value
+    return parse
 
 
 def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
@@ -54,13 +68,18 @@ def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
                       % DEFAULT_RESOLUTION)
     size.add_argument("--booth", dest="resolution", action="store_const",
                       const=BOOTH_RESOLUTION, help="booth size, %dx%d" % BOOTH_RESOLUTION)
-    g.add_argument("--orbit", type=float, nargs="?", const=ORBIT_DEFAULT, default=0.0,
-                   metavar="DEG", help=f"turn the camera DEG degrees per frame about the "
-                   f"drop's axis (default: fixed; --orbit alone: {ORBIT_DEFAULT:g})")
+    orbit_lo, orbit_hi = ORBIT_RANGE
+    g.add_argument("--orbit", type=bounded(*ORBIT_RANGE, "degrees per frame"), nargs="?",
+                   const=ORBIT_DEFAULT, default=0.0, metavar="DEG",
+                   help=f"turn the camera DEG degrees per frame about the drop's axis, "
+                        f"{orbit_lo:g} to {orbit_hi:g} (default: fixed; --orbit alone: "
+                        f"{ORBIT_DEFAULT:g})")
     if recording:
-        g.add_argument("--fps", type=positive, default=RenderSettings.fps,
-                       help=f"frames per second of the video (default: "
-                            f"{RenderSettings.fps:g})")
+        fps_lo, fps_hi = FPS_RANGE
+        g.add_argument("--fps", type=bounded(*FPS_RANGE, "frames per second"),
+                       default=RenderSettings.fps,
+                       help=f"frames per second of the video, {fps_lo:g} to {fps_hi:g} "
+                            f"(default: {RenderSettings.fps:g})")
         g.add_argument("--no-video", dest="video", action="store_false",
                        help="write the PNG frames only, no video.mp4 or preview.gif")
         g.add_argument("--no-render", dest="render", action="store_false",
@@ -89,4 +108,5 @@ def sink_from_args(args, resolved, out_dir: str, resume: bool = False):
                      resume=resume)
 
 
-__all__ = ["add_render_options", "settings_from_args", "sink_from_args", "parse_resolution"]
+__all__ = ["add_render_options", "settings_from_args", "sink_from_args", "parse_resolution",
+           "bounded", "FPS_RANGE", "ORBIT_RANGE"]

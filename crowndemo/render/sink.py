@@ -1,7 +1,8 @@
 """The frame sink of a recording: each frame rendered to ``OUT/frames/frame_00000.png``, and
 when the recording closes, ``OUT/video.mp4`` and ``OUT/preview.gif``. A recording that did not
 complete gets ``video.partial.mp4`` and ``preview.partial.gif`` instead, so a partial video
-never stands as complete. Every file is written under a temporary name and renamed.
+never stands as complete; so does one whose encoding failed (``close`` then raises). Every
+file is written under a temporary name and renamed.
 
 It times itself: ``frame_seconds`` (render, caption and PNG of each frame), ``render_seconds``
 (their sum) and ``encode_seconds``, to set against the simulation's time per frame.
@@ -94,13 +95,32 @@ class FrameSink:
         if not (self.settings.video and paths):
             return
         start = _time.perf_counter()
-        names = output_names(status)
+        try:
+            self._encode(paths, output_names(status))
+        except BaseException:
+            self._mark_partial()
+            raise
+        finally:
+            self.encode_seconds = _time.perf_counter() - start
+
+    def _encode(self, paths: List[str], names: Dict[str, str]) -> None:
+        """The MP4 and the GIF preview of the frames in ``paths``, named by ``names``."""
         mp4 = os.path.join(self.out_dir, names["video"])
         video.encode_mp4((video.read_image(p) for p in paths), mp4, self.settings.fps)
+        self.outputs["video"] = mp4
         gif = os.path.join(self.out_dir, names["preview"])
         video.encode_gif(paths, gif, self.settings.fps)
-        self.outputs = {"video": mp4, "preview": gif}
-        self.encode_seconds = _time.perf_counter() - start
+        self.outputs["preview"] = gif
+
+    def _mark_partial(self) -> None:
+        """Encoding failed: what it wrote takes the partial names, so that nothing stands
+        as complete."""
+        partial = output_names("failed")
+        for kind, path in list(self.outputs.items()):
+            target = os.path.join(self.out_dir, partial[kind])
+            if path != target:
+                os.replace(path, target)
+            self.outputs[kind] = target
 
     def timing(self) -> Dict[str, float]:
         n = len(self.frame_seconds)

@@ -11,6 +11,7 @@ from PIL import Image
 
 GIF_WIDTH = 320          # pixels: the preview's width
 GIF_FRAMES = 24          # at most this many frames in the preview
+GIF_MAX_DELAY_MS = 655350   # a GIF frame's delay is 16 bits of 1/100 s
 VIDEO_SUFFIXES = (".mp4",)   # what VideoWriter writes: H.264 in an MP4 container
 
 
@@ -100,10 +101,16 @@ def encode_gif(paths: Sequence[str], path: str, fps: float, width: int = GIF_WID
         im = Image.open(p).convert("RGB")
         h = max(2, round(im.height * width / im.width))
         images.append(im.resize((width, h), Image.LANCZOS).quantize(colors=128))
+    # Pillow merges identical frames, adding up their delays: keep even the sum in 16 bits
+    delay = min(GIF_MAX_DELAY_MS // len(images), max(20, int(1000 * step / fps)))
     tmp = _tmp(path)
-    images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], loop=0,
-                   duration=max(20, int(1000 * step / fps)), optimize=True)
-    os.replace(tmp, path)
+    try:
+        images[0].save(tmp, format="GIF", save_all=True, append_images=images[1:], loop=0,
+                       duration=delay, optimize=True)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):          # a failed save leaves no temporary file
+            os.remove(tmp)
     return len(images)
 
 
