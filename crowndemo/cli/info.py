@@ -171,8 +171,9 @@ def _preset_facts(r, tp) -> Dict:
         "binding_after_contact": est["binding_after_contact"],
         "run_seconds_estimate": est["run_seconds"],
         "run_seconds_at_U": est["run_seconds_at_U"],
+        "compile_seconds": est["compile_seconds"],
         "throughput": {"fluid_particle_steps_per_s": tp.rate,
-                       "all_particle_steps_per_s": tp.rate_total, "compile_s": tp.compile_s,
+                       "all_particle_steps_per_s": tp.rate_total,
                        "bytes_per_particle": tp.bytes_per_particle, "source": tp.source},
         "dimensionless": {"weber": we, "reynolds": re_num, "ohnesorge": oh,
                           "cossali_K": k, "cossali_K_splash": k_splash,
@@ -286,7 +287,8 @@ def _info_preset(args) -> int:
     print(f"  run time    ~{estimate.human_seconds(f['run_seconds_estimate'])} on the CPU of "
           f"BENCHMARKS.md (at least {estimate.human_seconds(f['run_seconds_at_U'])}): "
           f"{tp.rate_total:.3g} particle-steps/s counting every particle, / "
-          f"{estimate.CROWN_COST:g} for a crown step, + {tp.compile_s:g} s compiling")
+          f"{estimate.CROWN_COST:g} for a crown step, + {f['compile_seconds']:g} s compiling "
+          f"(a first run; 3-9 s with the kernels in Taichi's cache)")
     left = f["left_out"] or ["nothing"]
     for i, line in enumerate(left):
         print(f"  {'left out' if i == 0 else '':<11} {'- ' if f['left_out'] else ''}{line}")

@@ -20,10 +20,11 @@ examples:
 
 The presets are the YAML files in presets/ at the repository root ($CROWNDEMO_PRESETS names
 another folder). Particle counts come from building each scene with numpy (no kernel runs);
-counts marked ~ are scaled from a build at a coarser spacing. The run time is rough: compile
-+ (every particle) x steps / rate, with steps = t_end / dt at the drop's speed and the rate
-from the newest CPU section of BENCHMARKS.md; a splash faster than the drop takes smaller
-steps, so real runs take longer.
+counts marked ~ are scaled from a build at a coarser spacing. The run time is rough: a first
+run's compile (5 s in 2D, 50 s in 3D, measured; a run whose kernels are in Taichi's cache
+starts in 3-9 s) + (every particle) x steps / rate, with steps = t_end / dt at the drop's
+speed and the rate from the newest CPU section of BENCHMARKS.md; a splash faster than the
+drop takes smaller steps, so real runs take longer.
 """
 
 
@@ -73,7 +74,7 @@ def _presets(args) -> int:
     if args.json:
         print(json.dumps({"folder": str(folder), "throughput": {
             "fluid_particle_steps_per_s": tp.rate, "all_particle_steps_per_s": tp.rate_total,
-            "compile_s": tp.compile_s, "source": tp.source}, "presets": rows}, indent=2))
+            "source": tp.source}, "presets": rows}, indent=2))
     else:
         lang = args.lang
         titles = [row["title"].get(lang) or row["title"]["en"] for row in rows]
@@ -98,8 +99,10 @@ def _presets(args) -> int:
                 line += f"  {cell:<15}"
             print(line.rstrip())
         for line in textwrap.wrap(
-                f"~: particle count scaled from a coarser build. Run time: compile + every "
-                f"particle x steps x {estimate.CROWN_COST:g} (a crown step's cost) / "
+                f"~: particle count scaled from a coarser build. Run time: a first run's "
+                f"compile ({estimate.FIRST_RUN_COMPILE_S[2]:g} s in 2D, "
+                f"{estimate.FIRST_RUN_COMPILE_S[3]:g} s in 3D; 3-9 s with the kernels in "
+                f"Taichi's cache) + every particle x steps x {estimate.CROWN_COST:g} (a crown step's cost) / "
                 f"{tp.rate_total:.3g} particle-steps/s ({tp.rate:.3g} fluid; {tp.source}); "
                 f"steps: dt at the drop's speed until contact, then at the splash's "
                 f"{estimate.SPLASH_MACH:g} c, or with the Courant limit on relative speeds "

@@ -41,6 +41,11 @@ FALLBACK_BYTES = 92.0        # per particle (fields + cell grid), f32
 SPLASH_MACH = 0.5            # fastest particle / c after contact (measured, see above)
 SPLASH_RELATIVE_MACH = 0.3   # largest relative speed / c after contact (measured, see above)
 CROWN_COST = 0.8             # a crown step's cost per particle / the bench's (measured)
+# A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
+# (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
+# 2026-11-23, this CPU): 4.9 s in 2D, 51.5 s in 3D (13-19 s with --fast-compile, BENCHMARKS.md
+# "Compiling"). A run whose kernels are cached starts in 3-9 s: the estimates are a first run's.
+FIRST_RUN_COMPILE_S = {2: 5.0, 3: 50.0}
 
 
 @dataclass(frozen=True)
@@ -184,11 +189,13 @@ def steps_to_end(r: Resolved) -> Dict:
             "binding_after_contact": after[1], "steps": int(steps) + frames}
 
 
-def run_seconds(total: int, steps: int, tp: Throughput, cost: float = CROWN_COST) -> float:
-    """Compile + every particle (walls take part in the neighbour walks) x steps at the
-    bench's per-particle rate divided by the crown's cost factor. 2D steps are taken to cost
-    the 3D rate per particle (an upper figure: a 2D particle has fewer neighbours)."""
-    return tp.compile_s + total * steps * cost / tp.rate_total
+def run_seconds(total: int, steps: int, tp: Throughput, dim: int,
+                cost: float = CROWN_COST) -> float:
+    """A first run's compile (FIRST_RUN_COMPILE_S) + every particle (walls take part in the
+    neighbour walks) x steps at the bench's per-particle rate divided by the crown's cost
+    factor. 2D steps are taken to cost the 3D rate per particle (an upper figure: a 2D
+    particle has fewer neighbours)."""
+    return FIRST_RUN_COMPILE_S[dim] + total * steps * cost / tp.rate_total
 
 
 def memory_bytes(total: int, tp: Throughput) -> float:
@@ -199,9 +206,10 @@ def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Di
     """Counts, steps, run time and memory of one preset at one quality."""
     counts = particle_counts(r, exact_up_to)
     st = steps_to_end(r)
-    secs = run_seconds(counts["total"], st["steps"], tp)
-    return {"particles": counts, **st, "run_seconds": secs,
-            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, 1.0),
+    secs = run_seconds(counts["total"], st["steps"], tp, r.dim)
+    return {"particles": counts, **st, "run_seconds": secs, "compile_seconds":
+            FIRST_RUN_COMPILE_S[r.dim],
+            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, r.dim, 1.0),
             "memory_bytes": memory_bytes(counts["total"], tp)}
 
 
