@@ -164,3 +164,40 @@ def test_verdict_looks_at_the_seed_frames():
     assert v.crown_times == [o["time"] for o in v.series if o["crown"]]
     table = verdicts.markdown([v])
     assert "crown at (ms)" in table and "| 2, 2.5 |" in table
+
+
+# ---- report files -------------------------------------------------------------------------------
+def test_report_json_has_no_nan_or_infinity():
+    import json
+
+    from crowndemo.validate.report import dumps_json
+    data = {"a": math.nan, "b": [math.inf, -math.inf, 1.5], "c": np.float32("nan"),
+            "d": (np.float64(2.0), np.int64(3)), 4: {"e": np.float32(0.5)}}
+    back = json.loads(dumps_json(data), parse_constant=lambda c: pytest.fail(c))
+    assert back == {"a": None, "b": [None, None, 1.5], "c": None, "d": [2.0, 3],
+                    "4": {"e": 0.5}}
+
+
+def test_report_without_matplotlib_removes_an_older_plot(tmp_path, monkeypatch):
+    import sys
+
+    from crowndemo.validate.report import write_all
+    from crowndemo.validate.runner import Row
+    (tmp_path / "error_vs_time.png").write_text("an earlier run")
+    row = Row("hydrostatic-2d", 2, "base", "H/l0", 20.0, 2e-3, 628, 669, 1.0, 0.5, 384.6,
+              391.6, 0.018, "ok", "floor pressure")
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    paths = write_all([row], str(tmp_path))
+    assert "matplotlib" in paths["plot_skipped"]
+    assert not (tmp_path / "error_vs_time.png").exists()
+    assert (tmp_path / "validation.md").exists() and (tmp_path / "validation.csv").exists()
+
+
+def test_report_plot_with_nothing_to_plot_says_why(tmp_path):
+    pytest.importorskip("matplotlib")
+    from crowndemo.validate.report import plot
+    from crowndemo.validate.runner import Row
+    row = Row("hydrostatic-2d", 2, "base", "H/l0", 20.0, 2e-3, 628, 5, 1.0, 0.5, math.nan,
+              math.nan, math.inf, "unstable: n/n0", "floor pressure")
+    assert plot([row], str(tmp_path / "p.png")) == "no run with a finite, positive error"
+    assert not (tmp_path / "p.png").exists()

@@ -7,7 +7,6 @@ User mistakes (bad flags, parameters out of range, an unavailable arch) print on
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import sys
@@ -151,8 +150,8 @@ def clock(seconds: float) -> str:
 def json_text(data) -> str:
     """Strict JSON of a result: NaN and infinities (which JSON lacks) as null, numpy numbers
     as numbers."""
-    from ..record.metadata import finite_or_none
-    return json.dumps(finite_or_none(json.loads(json.dumps(data, default=float))), indent=2)
+    from ..strictjson import dumps
+    return dumps(data)
 
 
 def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:

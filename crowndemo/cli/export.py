@@ -3,10 +3,13 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import Optional
 
 from ..config import QUALITIES
 from .common import PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError, load_preset, \
     start_backend
+from .record import _recordings_option
+from .validate import require_folder
 
 EXPORT_EPILOG = """\
 examples:
@@ -16,8 +19,9 @@ examples:
 
 Reads RECORDINGS/PRESET (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
 ./recordings): the frames listed in its metadata.json. When there is no recording, the
-preset is recorded first (as 'crowndemo record PRESET' with the same --quality, --set and
-backend options), then exported. An interrupted recording exports the frames it has.
+preset is recorded first, without rendering (as 'crowndemo record PRESET --no-render' with
+the same --quality, --set and backend options), then exported. An interrupted recording
+exports the frames it has and says how to resume it.
 
 Writes OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
 data: velocity, pressure, number_density, kind, id; 2D runs get z = 0) and OUT/PRESET.pvd
@@ -27,9 +31,25 @@ With --quality or --set, an existing recording must have been made with the same
 """
 
 
+def _read_meta(path: Path) -> Optional[dict]:
+    """A recording's metadata.json (None when there is none); UsageError naming the file when
+    it cannot be read or is not a recording's (a truncated file, say)."""
+    from ..record.metadata import read
+
+    try:
+        meta = read(path)
+    except (OSError, ValueError) as e:          # JSONDecodeError and UnicodeDecodeError too
+        raise UsageError(f"{path}: cannot read it ({e}); allowed: the metadata.json of a "
+                         "recording: record it again") from None
+    if meta is not None and not (isinstance(meta, dict) and
+                                 isinstance(meta.get("frames"), list) and "complete" in meta):
+        raise UsageError(f"{path}: not a recording's metadata (no frames list); allowed: the "
+                         "metadata.json of a recording: record it again")
+    return meta
+
+
 def _export(args) -> int:
     from ..record import METADATA, RecordError, recording_dir, recordings_root, vtk
-    from ..record.metadata import read as read_metadata
     from ..record.recorder import fingerprint, record_preset
 
     if not args.vtk:
@@ -37,9 +57,12 @@ def _export(args) -> int:
     r = load_preset(args.preset, args)
     root = Path(args.recordings) if args.recordings else recordings_root()
     folder = recording_dir(r.name, root)
-    meta = read_metadata(folder / METADATA)
+    out = Path(args.out) if args.out else folder / "vtk"
+    require_folder("--out" if args.out else "--out (default RECORDINGS/PRESET/vtk)", str(out))
+    meta = _read_meta(folder / METADATA)
     code = 0
     if meta is None:
+        require_folder(_recordings_option(args), str(folder))
         print(f"{PROG}: no recording in {folder}: recording {r.name} ({r.quality}) first",
               file=sys.stderr, flush=True)
         be = start_backend(args)
@@ -48,9 +71,12 @@ def _export(args) -> int:
         except RecordError as e:
             raise UsageError(str(e)) from None
         if not res.complete:
-            print(f"{PROG}: the recording ended {res.status}", file=sys.stderr)
+            resume = ("" if res.status.startswith("unstable") else
+                      f"; '{PROG} record {r.name} --resume --no-render', with the same "
+                      "--quality, --set and --recordings, continues it")
+            print(f"{PROG}: the recording ended {res.status}{resume}", file=sys.stderr)
             code = 3 if res.status.startswith("unstable") else 130
-        meta = read_metadata(folder / METADATA)
+        meta = _read_meta(folder / METADATA)
     elif args.quality is not None or args.sets:
         from ..record.checkpoint import differences
         diff = differences(meta.get("fingerprint") or {}, fingerprint(r, args.precision))
@@ -64,7 +90,6 @@ def _export(args) -> int:
                          f"{', '.join(missing[:3])}")
     if not files:
         raise UsageError(f"{folder}: the recording has no frame yet")
-    out = Path(args.out) if args.out else folder / "vtk"
     keep = {f"{f.stem}.vtp" for f in files}
     for old in out.glob("frame_*.vtp"):
         if old.name not in keep:

@@ -1,12 +1,18 @@
 """``crowndemo sweep``: the crown / no-crown regime map over film thickness and impact speed."""
 from __future__ import annotations
 
-import json
 import os
+import re
+import shlex
 import sys
 
 from ..config import QUALITIES
-from .common import PRESET_HELP, PROG, SET_HELP, Fmt, load_preset, repo_root, start_backend
+from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, UsageError, load_preset, repo_root,
+                     start_backend)
+from .validate import require_folder
+
+# numbers like -1e-3 are values, not options (argparse alone knows only -1 and -0.5)
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 SWEEP_EPILOG = """\
 examples:
@@ -18,9 +24,47 @@ examples:
 Each point is the preset with scene.film and scene.speed set (checked like --set), run to its
 end time through one compiled simulator, and judged by the crown rule of
 crowndemo.validate.crown_metrics (a sheet at least D/4 high outside the drop's footprint).
-Writes regime.md, regime.json and, with matplotlib (pip install '.[plot]'), regime.png with
-Cossali et al.'s splash threshold K = We Oh^-0.4 = 2100 + 5880 (h/D)^1.44 drawn on it.
+Every point is checked before Taichi starts. Writes regime.md and regime.json (with the
+command and the --set overrides) and, with matplotlib (pip install '.[plot]'), regime.png
+with Cossali et al.'s splash threshold K = We Oh^-0.4 = 2100 + 5880 (h/D)^1.44 drawn on it;
+without matplotlib an older regime.png in --out is removed. Ctrl-C writes the points that
+ran, marked as a partial map, and exits 130.
 """
+
+
+def _point_error(what: str, key: str, e) -> str:
+    """A PresetError of a sweep point as a message naming the option and value (``what``)."""
+    if e.key == f"scene.{key}":                  # the value itself is out of range
+        return f"{what}: {e.why}" + (f"; allowed: {e.allowed}" if e.allowed else "")
+    return f"{what} does not fit the preset: {e}"
+
+
+def _resolve_points(args, quality: str, films, speeds) -> list:
+    """Every grid point's preset, checked before Taichi starts; a bad film or speed is named
+    by its option and value (each value alone first, then the pairs)."""
+    from ..config import PresetError, load
+    from ..validate.sweep import point_sets
+
+    def check(what: str, key: str, **point):
+        try:
+            return load(args.preset, quality, point_sets(args.sets, **point))
+        except PresetError as e:
+            raise UsageError(_point_error(what, key, e)) from None
+
+    for h in films:
+        check(f"--film {h:g}", "film", film=h)
+    for u in speeds:
+        check(f"--speed {u:g}", "speed", speed=u)
+    return [check(f"--film {h:g} with --speed {u:g}", "", film=h, speed=u)
+            for h in films for u in speeds]
+
+
+def _header(base, command: str, sets, interrupted: str) -> str:
+    """regime.md's head: what ran, with the command and the --set overrides."""
+    lines = [f"# Regime map: {base.name} ({base.quality}), D = {base.scene['drop'] * 1e3:g} mm",
+             "", f"Command: `{command}`; overrides (--set): "
+             f"{', '.join(f'`{s}`' for s in sets) or 'none'}.", ""]
+    return "\n".join(lines + ([interrupted, ""] if interrupted else []))
 
 
 def _sweep(args, argv) -> int:
@@ -30,38 +74,66 @@ def _sweep(args, argv) -> int:
     films = args.film or [0.5 * base.scene["film"], base.scene["film"], 2 * base.scene["film"]]
     speeds = args.speed or [2.0, 4.0, 6.0, 8.0]
     out = args.out or os.path.join(repo_root(), "reports")
+    require_folder("--out", out)
+    resolved = _resolve_points(args, base.quality, films, speeds)
     start_backend(args)
     print(f"{PROG}: sweep {base.name} ({base.quality}): {len(films)} films x {len(speeds)} "
           "speeds", file=sys.stderr, flush=True)
-    points = sweep.run(args.preset, films, speeds, base.quality, args.sets,
-                       on_point=lambda p: print(
-                           f"  h = {p.film * 1e3:6.3g} mm  U = {p.speed:5.3g} m/s  "
-                           f"{'-' if p.crown is None else ('crown' if p.crown else 'no crown'):<9}"
-                           f"  {p.wall_s:6.1f} s  {p.outcome}", file=sys.stderr, flush=True))
-    os.makedirs(out, exist_ok=True)
-    drop, liquid = base.scene["drop"], base.liquid
-    table = sweep.markdown(points, drop, liquid)
-    with open(os.path.join(out, "regime.md"), "w") as f:
-        f.write(f"# Regime map: {base.name} ({base.quality}), D = {drop * 1e3:g} mm\n\n"
-                f"{table}\n")
-    with open(os.path.join(out, "regime.json"), "w") as f:
-        json.dump({"preset": base.name, "quality": base.quality, "drop_m": drop,
-                   "liquid": liquid, "points": [p.as_dict() for p in points]}, f, indent=1)
-    why = sweep.plot(points, drop, liquid, os.path.join(out, "regime.png"),
-                     f"{base.name} ({base.quality}, {base.dim}D, l0 = {base.l0 * 1e3:g} mm), "
-                     f"D = {drop * 1e3:g} mm")
-    if args.record:
+    points = []
+
+    def on_point(p):
+        points.append(p)
+        print(f"  h = {p.film * 1e3:6.3g} mm  U = {p.speed:5.3g} m/s  "
+              f"{'-' if p.crown is None else ('crown' if p.crown else 'no crown'):<9}"
+              f"  {p.wall_s:6.1f} s  {p.outcome}", file=sys.stderr, flush=True)
+    interrupted = ""
+    try:
+        sweep.run_resolved(resolved, on_point=on_point)
+    except KeyboardInterrupt:
+        interrupted = (f"**Interrupted (Ctrl-C): {len(points)} of {len(resolved)} points ran; "
+                       "a partial map.**")
+        print(f"{PROG}: interrupted (Ctrl-C): writing the {len(points)} points that ran",
+              file=sys.stderr)
+    command = " ".join([PROG] + [shlex.quote(a) for a in argv])
+    table, why = _write(out, base, points, len(resolved), command, args.sets, interrupted)
+    if args.record and interrupted:
+        print(f"{PROG}: docs/regime.md not rewritten: the sweep was interrupted",
+              file=sys.stderr)
+    elif args.record:
         _record(base, table, out, why is None, argv)
     print(table)
     print(f"{PROG}: wrote {out}/regime.md, regime.json"
           + (", regime.png" if why is None else f" (no image: {why})"), file=sys.stderr)
-    return 0
+    return 130 if interrupted else 0
+
+
+def _write(out: str, base, points, planned: int, command: str, sets, interrupted: str):
+    """regime.md, regime.json and regime.png (or, without it, no older one) in ``out``;
+    returns the table and why there is no image (None when there is)."""
+    from ..validate import report, sweep
+
+    drop, liquid = base.scene["drop"], base.liquid
+    table = sweep.markdown(points, drop, liquid)
+    os.makedirs(out, exist_ok=True)
+    with open(os.path.join(out, "regime.md"), "w") as f:
+        f.write(f"{_header(base, command, sets, interrupted)}\n{table}\n")
+    with open(os.path.join(out, "regime.json"), "w") as f:
+        report.dump_json({"preset": base.name, "quality": base.quality, "command": command,
+                          "sets": list(sets), "interrupted": bool(interrupted),
+                          "points_planned": planned, "drop_m": drop, "liquid": liquid,
+                          "points": [p.as_dict() for p in points]}, f)
+    why = sweep.plot(points, drop, liquid, os.path.join(out, "regime.png"),
+                     f"{base.name} ({base.quality}, {base.dim}D, l0 = {base.l0 * 1e3:g} mm), "
+                     f"D = {drop * 1e3:g} mm" + (f"; --set {' '.join(sets)}" if sets else ""))
+    if why is not None:                            # not an earlier run's image beside it
+        for path in report.remove_stale(out, ["regime.png"], []):
+            print(f"{PROG}: removed {path} (an earlier run's)", file=sys.stderr)
+    return table, why
 
 
 def _record(base, table: str, out: str, has_image: bool, argv) -> None:
     """docs/regime.md (and docs/regime.png) at the repository root, linked from VALIDATION.md."""
     import datetime
-    import shlex
     import shutil
 
     from .validate import _machine
@@ -88,6 +160,7 @@ def register(sub, common) -> None:
                        description="Run a preset over film thicknesses and impact speeds and "
                                    "draw the crown / no-crown regime map with the literature's "
                                    "splash threshold.")
+    p._negative_number_matcher = NEGATIVE_NUMBER     # argparse's own test, widened
     p.add_argument("preset", nargs="?", default="quick-2d", metavar="PRESET",
                    help=PRESET_HELP + " (default: quick-2d)")
     p.add_argument("--film", type=float, nargs="+", metavar="H",

@@ -3,7 +3,6 @@ run time), the stability suite, and the seed's crown / no-crown observations."""
 from __future__ import annotations
 
 import datetime
-import json
 import os
 import platform
 import shlex
@@ -12,6 +11,10 @@ import sys
 from .common import PROG, Fmt, UsageError, repo_root, start_backend
 
 GROUPS = ("stability", "verdicts")
+# the report files a run writes in --out; those it does not write are an earlier run's
+REPORT_FILES = ("validation.md", "validation.csv", "error_vs_time.png", "stability.md",
+                "verdicts.md")
+INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
 
 VALIDATE_EPILOG = """\
 examples:
@@ -25,12 +28,53 @@ examples:
 
 Cases: hydrostatic, dam-break, drop-oscillation, laplace (each -2d and -3d), crown-base-quick,
 crown-base-3m-drop; groups: stability, verdicts. Each case runs at three resolutions in the
-base settings and, at the middle one, with f64, half the time-step safety numbers, the other
-pressure-gradient forms, and (crown) the untrimmed domain with side walls. Output in --out
-(default reports/): validation.md, validation.csv, error_vs_time.png (with matplotlib:
-pip install '.[plot]'), stability.md, verdicts.md, and all of it as validation.json.
+base settings and, at the middle one, in its settings variants (--list says which case runs
+which):
+  {variants}
+Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
+matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
+validation.json (strict JSON: null for a value that is not a finite number). Report files in
+--out that this run does not write (an earlier run's) are removed. Ctrl-C writes the runs
+finished so far, marked as an interrupted run, and exits 130.
 Wall times exclude the first step of each run, which compiles the kernels (reported apart).
 """
+
+
+def variants_text() -> str:
+    """The settings variants the cases run, from the case table (read when help is shown)."""
+    from ..config import PresetError
+    from ..validate.cases import all_cases
+    from ..validate.runner import variant_names
+    try:
+        return ", ".join(variant_names(all_cases(full=True).values()))
+    except PresetError as e:
+        return f"unknown: {e}"
+
+
+class _VariantsFmt(Fmt):
+    """Fills {variants} in the help texts when they are shown, so they list the code's."""
+
+    def add_text(self, text):
+        if text and "{variants}" in text:
+            text = text.replace("{variants}", variants_text())
+        super().add_text(text)
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        return text.replace("{variants}", variants_text()) if "{variants}" in text else text
+
+
+def require_folder(option: str, folder: str) -> None:
+    """UsageError, before any simulation, when files cannot be written into ``folder`` (a
+    file, a parent that is a file, no permission); tried for real and left as it was."""
+    from ..record.files import folder_problem
+
+    bad = folder_problem(folder)
+    if bad:
+        at, what = bad
+        where = "" if os.path.abspath(at) == os.path.abspath(folder) else f"{at}: "
+        raise UsageError(f"{option} {folder}: {where}{what}; allowed: a folder that exists or "
+                         "can be created, and can be written")
 
 
 def _machine() -> str:
@@ -46,82 +90,138 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
-def _validate(args, argv) -> int:
-    from ..validate import cases as cases_mod
-    from ..validate import report, runner, stability, verdicts
+def _list(table, extra) -> int:
+    from ..validate import stability, verdicts
 
-    table = cases_mod.all_cases(full=True)
-    if args.list:
-        for c in table.values():
-            print(f"{c.name:<22} {c.quantity}; reference: {c.reference}; {c.resolution} = "
-                  f"{', '.join(f'{s:g}' for s in c.scales)} (quick: "
-                  f"{', '.join(f'{s:g}' for s in c.quick)})")
-        print(f"{'stability':<22} stiff and extreme drop-on-film cases: "
-              f"{', '.join(stability.cases(True))}")
-        print(f"{'verdicts':<22} crown or not for {', '.join(verdicts.SEED)} (the seed's runs)")
-        return 0
-    names = args.cases or (list(table) + list(GROUPS))
+    if extra:
+        raise UsageError(f"--list takes no case names (got {', '.join(extra)}); allowed: "
+                         f"'{PROG} validate --list' alone")
+    for c in table.values():
+        print(f"{c.name:<22} {c.quantity}; reference: {c.reference}; {c.resolution} = "
+              f"{', '.join(f'{s:g}' for s in c.scales)} (quick: "
+              f"{', '.join(f'{s:g}' for s in c.quick)}); variants: "
+              f"{', '.join(c.variants) or 'none'}")
+    print(f"{'stability':<22} stiff and extreme drop-on-film cases: "
+          f"{', '.join(stability.cases(True))}")
+    print(f"{'verdicts':<22} crown or not for {', '.join(verdicts.SEED)} (the seed's runs)")
+    return 0
+
+
+def _names(args, table) -> list:
+    """The cases and groups to run, each once, in the order given; UsageError for unknown."""
+    names = list(dict.fromkeys(args.cases)) or (list(table) + list(GROUPS))
     if args.quick and not args.cases:
         names = [n for n in names if n not in ("crown-base-3m-drop", "verdicts")]
     unknown = [n for n in names if n not in table and n not in GROUPS]
     if unknown:
         raise UsageError(f"unknown case {', '.join(unknown)}; allowed: "
                          f"{', '.join(list(table) + list(GROUPS))} (see '{PROG} validate --list')")
-    be = start_backend(args)
-    out = os.path.join(repo_root(), "reports") if args.out is None else args.out
+    return names
+
+
+def _run(args, names, table, found, say) -> None:
+    """Run the selected cases and groups; every finished row goes into ``found`` at once, so
+    that an interrupted run keeps it."""
+    from ..validate import runner, stability, verdicts
+
+    def row_line(r):
+        found["cases"].append(r)
+        err = f"{100 * r.error:.2f} %" if r.error == r.error and r.error != float("inf") else "-"
+        say(f"  {r.case:<20} {r.variant:<14} {r.resolution} = {r.scale:<6g} {r.particles:>7,} "
+            f"particles {r.steps:>6,} steps {r.wall_s:7.1f} s  error {err:>9}  {r.outcome}")
+
+    def stab_line(r):
+        found["stability"].append(r)
+        say(f"  {r.case:<18} {r.steps:>6,} steps {r.wall_s:6.1f} s  {r.outcome}"
+            f"{'' if r.passed else '  FAILED: ' + '; '.join(r.checks)}")
+
+    def verdict_line(v):
+        found["verdicts"].append(v)
+        say(f"  {v.preset:<12} {'crown' if v.crown else 'no crown':<9} (seed: "
+            f"{'crown' if v.seed_crown else 'no crown'}) {v.wall_s:6.0f} s  {v.outcome}")
+
+    selected = [table[n] for n in names if n in table]
+    if selected:
+        say(f"{PROG}: validating {len(selected)} case(s){' (quick)' if args.quick else ''}")
+        runner.run_suite(selected, quick=args.quick, variants=not args.no_variants,
+                         on_row=row_line)
+    if "stability" in names:
+        say(f"{PROG}: stability suite")
+        stability.run_suite(full=not args.quick, on_row=stab_line)
+    if "verdicts" in names:
+        say(f"{PROG}: crown verdicts at quality {args.quality}")
+        verdicts.run_all(quality=args.quality, on_row=verdict_line)
+
+
+def _write(out, header, rows, stab, verd) -> dict:
+    """The report files in ``out``. The cases' report (validation.md, .csv and the plot) is
+    replaced as a whole: a plot this run could not draw is removed, not left to stand for it.
+    stability.md and verdicts.md of runs that did not run them are left, each headed by its
+    own run's command and date (a quick subset must not delete an hour-long run's report)."""
+    from ..validate import report, stability, verdicts
+
     os.makedirs(out, exist_ok=True)
+    paths = report.write_all(rows, out, header) if rows else {}
+    for key, items, md in (("stability", stab, stability.markdown),
+                           ("verdicts", verd, verdicts.markdown)):
+        if items:
+            paths[key] = os.path.join(out, f"{key}.md")
+            with open(paths[key], "w") as f:
+                f.write("\n".join(header + ["", md(items), ""]))
+    written = [v for k, v in paths.items() if k != "plot_skipped"]
+    family = REPORT_FILES[:3] if rows else ()
+    for path in report.remove_stale(out, family, written):
+        print(f"{PROG}: removed {path} (an earlier run's; this run did not write it)",
+              file=sys.stderr)
+    return paths
+
+
+def _validate(args, argv) -> int:
+    from ..validate import cases as cases_mod
+    from ..validate import report, stability, verdicts
+
+    table = cases_mod.all_cases(full=True)
+    if args.list:
+        return _list(table, args.cases)
+    names = _names(args, table)
+    out = os.path.join(repo_root(), "reports") if args.out is None else args.out
+    require_folder("--out", out)
+    be = start_backend(args)
 
     def say(text):
         if not args.json:
             print(text, file=sys.stderr, flush=True)
 
-    def row_line(r):
-        err = f"{100 * r.error:.2f} %" if r.error == r.error and r.error != float("inf") else "-"
-        say(f"  {r.case:<20} {r.variant:<14} {r.resolution} = {r.scale:<6g} {r.particles:>7,} "
-            f"particles {r.steps:>6,} steps {r.wall_s:7.1f} s  error {err:>9}  {r.outcome}")
-
     result = {"machine": _machine(), "date": datetime.date.today().isoformat(),
               "command": " ".join([PROG] + [shlex.quote(a) for a in argv]),
               "arch": be.resolved, "precision": be.precision, "quick": args.quick}
-    selected = [table[n] for n in names if n in table]
-    rows = []
-    if selected:
-        say(f"{PROG}: validating {len(selected)} case(s){' (quick)' if args.quick else ''}")
-        rows = runner.run_suite(selected, quick=args.quick, variants=not args.no_variants,
-                                on_row=row_line)
-        result["cases"] = [r.as_dict() for r in rows]
-    stab = []
-    if "stability" in names:
-        say(f"{PROG}: stability suite")
-        stab = stability.run_suite(full=not args.quick, on_row=lambda r: say(
-            f"  {r.case:<18} {r.steps:>6,} steps {r.wall_s:6.1f} s  {r.outcome}"
-            f"{'' if r.passed else '  FAILED: ' + '; '.join(r.checks)}"))
-        result["stability"] = [r.as_dict() for r in stab]
-    verd = []
-    if "verdicts" in names:
-        say(f"{PROG}: crown verdicts at quality {args.quality}")
-        verd = verdicts.run_all(quality=args.quality, on_row=lambda v: say(
-            f"  {v.preset:<12} {'crown' if v.crown else 'no crown':<9} (seed: "
-            f"{'crown' if v.seed_crown else 'no crown'}) {v.wall_s:6.0f} s  {v.outcome}"))
-        result["verdicts"] = [v.as_dict() for v in verd]
+    found = {"cases": [], "stability": [], "verdicts": []}
+    interrupted = False
+    try:
+        _run(args, names, table, found, say)
+    except KeyboardInterrupt:
+        interrupted = True
+        print(f"{PROG}: interrupted (Ctrl-C): writing the "
+              f"{sum(map(len, found.values()))} runs that finished", file=sys.stderr)
+    rows, stab, verd = found["cases"], found["stability"], found["verdicts"]
+    result["interrupted"] = interrupted
+    ran = {"cases": any(n in table for n in names), "stability": "stability" in names,
+           "verdicts": "verdicts" in names}
+    result.update({k: [r.as_dict() for r in found[k]] for k in found if ran[k]})
     header = [f"Machine: {result['machine']}; arch {be.resolved}, {be.precision}; "
               f"date {result['date']}.", "", f"Command: `{result['command']}`"]
-    paths = report.write_all(rows, out, header) if rows else {}
-    if stab:
-        paths["stability"] = os.path.join(out, "stability.md")
-        with open(paths["stability"], "w") as f:
-            f.write("\n".join(header + ["", stability.markdown(stab), ""]))
-    if verd:
-        paths["verdicts"] = os.path.join(out, "verdicts.md")
-        with open(paths["verdicts"], "w") as f:
-            f.write("\n".join(header + ["", verdicts.markdown(verd), ""]))
+    if interrupted:
+        header += ["", INTERRUPTED]
+    paths = _write(out, header, rows, stab, verd)
     result["files"] = paths
     with open(os.path.join(out, "validation.json"), "w") as f:
-        json.dump(result, f, indent=1, default=float)
-    if args.record:
+        report.dump_json(result, f)
+    if args.record and interrupted:
+        print(f"{PROG}: VALIDATION.md not rewritten: the run was interrupted", file=sys.stderr)
+    elif args.record:
         _record(result, rows, stab, verd, paths)
     if args.json:
-        print(json.dumps(result, indent=1, default=float))
+        print(report.dumps_json(result))
     else:
         if rows:
             print(report.markdown(rows))
@@ -131,8 +231,9 @@ def _validate(args, argv) -> int:
             print(verdicts.markdown(verd))
         for k, v in paths.items():
             print(f"{k}: {v}", file=sys.stderr)
-    failed = [r for r in stab if not r.passed]
-    return 1 if failed else 0
+    if interrupted:
+        return 130
+    return 1 if any(not r.passed for r in stab) else 0
 
 
 def _record(result, rows, stab, verd, paths) -> None:
@@ -169,7 +270,8 @@ def _record(result, rows, stab, verd, paths) -> None:
 
 def register(sub, common) -> None:
     from ..config import QUALITIES
-    p = sub.add_parser("validate", parents=common, formatter_class=Fmt, epilog=VALIDATE_EPILOG,
+    p = sub.add_parser("validate", parents=common, formatter_class=_VariantsFmt,
+                       epilog=VALIDATE_EPILOG,
                        help="error against run time for the reference cases; stability suite",
                        description="Run the validation cases (method.md §7-8) at several "
                                    "resolutions and settings, the stability suite and the "
@@ -181,13 +283,14 @@ def register(sub, common) -> None:
                    help="the coarse resolutions only, stability to 0.4 ms, no 3m-drop crown "
                         "and no verdicts unless named")
     p.add_argument("--no-variants", action="store_true",
-                   help="base settings only (no f64, safety/2, gradient forms, untrimmed)")
+                   help="base settings only (no {variants})")
     p.add_argument("--quality", choices=QUALITIES, default="draft",
                    help="quality of the verdict runs (default: draft)")
     p.add_argument("--out", metavar="DIR", default=None,
                    help="folder for the reports (default: reports/ at the repository root)")
     p.add_argument("--record", action="store_true",
                    help="rewrite VALIDATION.md at the repository root with the results")
-    p.add_argument("--list", action="store_true", help="list the cases and exit")
+    p.add_argument("--list", action="store_true",
+                   help="list the cases (with their variants) and groups, and exit")
     p.add_argument("--json", action="store_true", help="print everything as one JSON object")
     p.set_defaults(func=_validate)

@@ -8,12 +8,12 @@ killed outright therefore leaves ``complete: false``.
 from __future__ import annotations
 
 import json
-import math
 import platform
 from dataclasses import asdict
 from pathlib import Path
 from typing import Optional
 
+from ..strictjson import finite_or_none
 from .files import CHECKPOINT, PathLike, atomic_write_json
 from .runlog import RunLog
 from .sinks import COMPLETE, RUNNING
@@ -28,17 +28,6 @@ def versions() -> dict:
     from .. import __version__
     return {"crowndemo": __version__, "taichi": ".".join(map(str, taichi.__version__)),
             "numpy": numpy.__version__, "python": platform.python_version()}
-
-
-def finite_or_none(x):
-    """JSON has no Infinity or NaN: non-finite floats become null (recursively)."""
-    if isinstance(x, float) and not math.isfinite(x):
-        return None
-    if isinstance(x, dict):
-        return {str(k): finite_or_none(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [finite_or_none(v) for v in x]
-    return x
 
 
 def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoint_every: int,

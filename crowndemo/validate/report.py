@@ -5,7 +5,9 @@ from __future__ import annotations
 import csv
 import math
 import os
-from typing import Dict, Iterable, List, Optional, Sequence
+from typing import IO, Any, Dict, Iterable, List, Optional, Sequence
+
+from .. import strictjson
 
 COLUMNS = ("case", "variant", "resolution", "scale", "l0", "particles", "steps", "wall_s",
            "compile_s", "measured", "reference", "error", "outcome")
@@ -75,13 +77,15 @@ def plot(rows: Sequence, path: str) -> Optional[str]:
         import matplotlib.pyplot as plt
     except ImportError:
         return "matplotlib is not installed (pip install '.[plot]')"
-    fig, ax = plt.subplots(figsize=(8, 5.5))
     cases: Dict[str, list] = {}
     for r in rows:
         if r.outcome == "ok" and math.isfinite(r.error) and r.error > 0:
             cases.setdefault(r.case, []).append(r)
+    if not cases:                       # nothing for log-log axes
+        return "no run with a finite, positive error"
+    fig, ax = plt.subplots(figsize=(8, 5.5))
     markers = {"f64": "s", "safety/2": "^", "gradient=sum": "D", "gradient=seed": "v",
-               "untrimmed": "P"}
+               "untrimmed": "P", "plane-floor": "<", "relative-courant": ">"}
     for i, (name, rs) in enumerate(sorted(cases.items())):
         colour = f"C{i % 10}"
         base = sorted((r for r in rs if r.variant == "base"), key=lambda r: r.wall_s)
@@ -121,4 +125,27 @@ def write_all(rows: Sequence, folder: str, header: Iterable[str] = ()) -> Dict[s
         out["plot"] = png
     else:
         out["plot_skipped"] = why
+        remove_stale(folder, ["error_vs_time.png"], [])     # an older run's plot
     return out
+
+
+def remove_stale(folder: str, names: Iterable[str], written: Iterable[str]) -> List[str]:
+    """Remove the report files ``names`` in ``folder`` that this run did not write (an
+    earlier run's, which would be read as this run's); returns the removed paths."""
+    keep = {os.path.abspath(p) for p in written}
+    removed = []
+    for name in names:
+        path = os.path.join(folder, name)
+        if os.path.isfile(path) and os.path.abspath(path) not in keep:
+            os.remove(path)
+            removed.append(path)
+    return removed
+
+
+def dump_json(data: Any, f: IO[str]) -> None:
+    """``data`` as strict JSON (null for NaN and Infinity) into the open file ``f``."""
+    strictjson.dump(data, f, indent=1)
+
+
+def dumps_json(data: Any) -> str:
+    return strictjson.dumps(data, indent=1)

@@ -57,6 +57,11 @@ def run_one(case: Case, scale: float, variant: str = "base") -> Row:
                res.error, "ok", case.quantity, dict(res.extra))
 
 
+def variant_names(cases: Iterable[Case]) -> List[str]:
+    """Every settings variant the given cases run, in first-seen order (for --help)."""
+    return list(dict.fromkeys(v for c in cases for v in c.variants))
+
+
 def plan(case: Case, quick: bool, variants: bool) -> List[tuple]:
     """(scale, variant) pairs: every resolution in the base settings, and each variant at the
     middle resolution (the finest of a quick plan)."""

@@ -28,13 +28,29 @@ class Point:
         return asdict(self)
 
 
+def point_sets(sets: Sequence[str], film: Optional[float] = None,
+               speed: Optional[float] = None) -> List[str]:
+    """The --set overrides of a point: ``sets`` and scene.film / scene.speed."""
+    return list(sets) + ([] if film is None else [f"scene.film={film!r}"]) + \
+        ([] if speed is None else [f"scene.speed={speed!r}"])
+
+
+def resolve(preset: str, films: Sequence[float], speeds: Sequence[float],
+            quality: str = "draft", sets: Sequence[str] = ()) -> list:
+    """Every (film, speed) point's preset, checked (PresetError on the first bad one)."""
+    return [config.load(preset, quality, point_sets(sets, h, u)) for h in films for u in speeds]
+
+
 def run(preset: str, films: Sequence[float], speeds: Sequence[float], quality: str = "draft",
         sets: Sequence[str] = (), on_point: Optional[Callable[[Point], None]] = None
         ) -> List[Point]:
     """Every (film, speed) pair; each is checked through the preset's validation first."""
-    resolved = [config.load(preset, quality, list(sets) + [f"scene.film={h!r}",
-                                                           f"scene.speed={u!r}"])
-                for h in films for u in speeds]
+    return run_resolved(resolve(preset, films, speeds, quality, sets), on_point)
+
+
+def run_resolved(resolved: Sequence, on_point: Optional[Callable[[Point], None]] = None
+                 ) -> List[Point]:
+    """Each resolved point in turn through one compiled simulator."""
     session = Session()
     points = []
     for r in resolved:
@@ -59,6 +75,8 @@ def plot(points: List[Point], drop: float, liquid: dict, path: str, title: str) 
         import matplotlib.pyplot as plt
     except ImportError:
         return "matplotlib is not installed (pip install '.[plot]')"
+    if not points:
+        return "no point ran"
     fig, ax = plt.subplots(figsize=(7, 5))
     style = {True: ("o", "C3", "crown"), False: ("s", "C0", "no crown"),
              None: ("x", "grey", "stopped early")}
