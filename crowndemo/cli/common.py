@@ -147,13 +147,6 @@ def clock(seconds: float) -> str:
     return f"{s // 60}:{s % 60:02d}"
 
 
-def json_text(data) -> str:
-    """Strict JSON of a result: NaN and infinities (which JSON lacks) as null, numpy numbers
-    as numbers."""
-    from ..strictjson import dumps
-    return dumps(data)
-
-
 def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:
     """The JSON part shared by `scene` and `run`: stats, health with peaks, particles."""
     d = run["stats"].as_dict()
@@ -223,6 +216,21 @@ def load_presets(args) -> list:
     if getattr(args, "playlist", None):
         specs += read_playlist(args.playlist)
     return [config.load(spec, quality, args.sets, source) for spec, source in specs]
+
+
+def require_folder(option: str, folder, shown=None) -> None:
+    """UsageError, before any simulation, when files cannot be written into ``folder`` (a
+    file, a parent that is a file, no permission); tried for real and left as it was. The
+    message names ``option`` and ``shown`` (default: the folder itself)."""
+    from ..record.files import folder_problem
+
+    shown = folder if shown is None else shown
+    bad = folder_problem(folder)
+    if bad:
+        at, what = bad
+        where = "" if os.path.abspath(at) == os.path.abspath(shown) else f"{at}: "
+        raise UsageError(f"{option} {shown}: {where}{what}; allowed: a folder that exists or "
+                         "can be created, and can be written")
 
 
 def repo_root() -> str:

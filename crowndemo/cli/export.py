@@ -7,9 +7,8 @@ from typing import Optional
 
 from ..config import QUALITIES
 from .common import PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError, load_preset, \
-    start_backend
+    require_folder, start_backend
 from .record import _recordings_option
-from .validate import require_folder
 
 EXPORT_EPILOG = """\
 examples:

@@ -5,8 +5,9 @@ from __future__ import annotations
 import math
 from typing import Dict
 
+from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
-from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, json_text, load_preset)
+from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, load_preset)
 
 
 INFO_EPILOG = """\
@@ -86,7 +87,7 @@ def _info_lattice(args) -> int:
            "limits_s": all_limits, "safety": safety, "dt_s": dt, "binding": binding,
            "binding_ties": ties, "model": Model.describe(model)}
     if args.json:
-        print(json_text(out))
+        print(strictjson.dumps(out))
         return 0
 
     def lim_line(name, rule):
@@ -202,7 +203,7 @@ def _info_preset(args) -> int:
     tp = estimate.throughput()
     f = _preset_facts(r, tp)
     if args.json:
-        print(json_text(f))
+        print(strictjson.dumps(f))
         return 0
     s, liq, p = f["scene"], f["liquid"], f["particles"]
     src = {k: v["key"] for k, v in f["sources"].items()}

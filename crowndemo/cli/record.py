@@ -12,7 +12,8 @@ from typing import List, Optional
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
 from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError,
-                     add_sequence_options, load_presets, print_summary, start_backend)
+                     add_sequence_options, load_presets, print_summary, require_folder,
+                     start_backend)
 
 RECORD_EPILOG = """\
 examples:
@@ -93,15 +94,9 @@ def _check_folders(root: Path, names: List[str], args) -> None:
     """UsageError, before Taichi starts, when a recording folder ROOT/NAME cannot be created
     or written (ROOT a file, a parent that cannot hold folders, no permission)."""
     from ..record import recording_dir
-    from ..record.files import folder_problem
 
     for name in names:
-        bad = folder_problem(recording_dir(name, root))
-        if bad:
-            at, what = bad
-            where = "" if at == root else f"{at}: "
-            raise UsageError(f"{_recordings_option(args)} {root}: {where}{what}; allowed: a "
-                             "folder that exists or can be created, and can be written")
+        require_folder(_recordings_option(args), recording_dir(name, root), shown=root)
 
 
 def _resume_point(r, folder: Path, args):

@@ -4,10 +4,11 @@ from __future__ import annotations
 import sys
 import time
 
+from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
 from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, add_sequence_options,
-                     json_text, load_presets, print_summary, run_result, simulate, start_backend)
+                     load_presets, print_summary, run_result, simulate, start_backend)
 
 
 RUN_EPILOG = """\
@@ -99,7 +100,7 @@ def _run(args) -> int:
                       file=sys.stderr)
                 break
     if args.json:
-        print(json_text(results[0] if len(results) == 1 else results))
+        print(strictjson.dumps(results[0] if len(results) == 1 else results))
     elif len(results) > 1:
         print(f"{len(results)} runs in {time.perf_counter() - t_all:.2f} s")
     return 130 if stop.requested else 0

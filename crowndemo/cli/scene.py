@@ -7,9 +7,9 @@ import sys
 import time
 from typing import Dict
 
+from .. import strictjson
 from ..core.params import GRADIENT_FORMS, Numerics, ParameterError
-from .common import (NUMERICS, PROG, Fmt, json_text, print_summary, run_result, simulate,
-                     start_backend)
+from .common import (NUMERICS, PROG, Fmt, print_summary, run_result, simulate, start_backend)
 
 
 # per scene, by dimension: the defaults of its options (keys are the builders' keywords)
@@ -201,7 +201,7 @@ def _scene(args) -> int:
               "resolved_arch": be.resolved, "precision": be.precision,
               **run_result(run, counts, setup_s), "observables": obs}
     if args.json:
-        print(json_text(result))
+        print(strictjson.dumps(result))
         return 0
     size = ", ".join(f"{k} {v:g}" for k, v in val.items() if k not in ("l0", "t_end"))
     head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {size}; gradient "

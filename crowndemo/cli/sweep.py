@@ -8,8 +8,7 @@ import sys
 
 from ..config import QUALITIES
 from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, UsageError, load_preset, repo_root,
-                     start_backend)
-from .validate import require_folder
+                     require_folder, start_backend)
 
 # numbers like -1e-3 are values, not options (argparse alone knows only -1 and -0.5)
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")

@@ -8,12 +8,9 @@ import platform
 import shlex
 import sys
 
-from .common import PROG, Fmt, UsageError, repo_root, start_backend
+from .common import PROG, Fmt, UsageError, repo_root, require_folder, start_backend
 
 GROUPS = ("stability", "verdicts")
-# the report files a run writes in --out; those it does not write are an earlier run's
-REPORT_FILES = ("validation.md", "validation.csv", "error_vs_time.png", "stability.md",
-                "verdicts.md")
 INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
 
 VALIDATE_EPILOG = """\
@@ -33,9 +30,10 @@ which):
   {variants}
 Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
 matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
-validation.json (strict JSON: null for a value that is not a finite number). Report files in
---out that this run does not write (an earlier run's) are removed. Ctrl-C writes the runs
-finished so far, marked as an interrupted run, and exits 130.
+validation.json (strict JSON: null for a value that is not a finite number). A run that
+measures cases replaces their report as a whole (an older plot it could not redraw is
+removed); stability.md and verdicts.md of earlier runs stay, headed by their own command.
+Ctrl-C writes the runs finished so far, marked as an interrupted run, and exits 130.
 Wall times exclude the first step of each run, which compiles the kernels (reported apart).
 """
 
@@ -62,19 +60,6 @@ class _VariantsFmt(Fmt):
     def _get_help_string(self, action):
         text = action.help or ""
         return text.replace("{variants}", variants_text()) if "{variants}" in text else text
-
-
-def require_folder(option: str, folder: str) -> None:
-    """UsageError, before any simulation, when files cannot be written into ``folder`` (a
-    file, a parent that is a file, no permission); tried for real and left as it was."""
-    from ..record.files import folder_problem
-
-    bad = folder_problem(folder)
-    if bad:
-        at, what = bad
-        where = "" if os.path.abspath(at) == os.path.abspath(folder) else f"{at}: "
-        raise UsageError(f"{option} {folder}: {where}{what}; allowed: a folder that exists or "
-                         "can be created, and can be written")
 
 
 def _machine() -> str:
@@ -155,9 +140,9 @@ def _run(args, names, table, found, say) -> None:
 
 def _write(out, header, rows, stab, verd) -> dict:
     """The report files in ``out``. The cases' report (validation.md, .csv and the plot) is
-    replaced as a whole: a plot this run could not draw is removed, not left to stand for it.
-    stability.md and verdicts.md of runs that did not run them are left, each headed by its
-    own run's command and date (a quick subset must not delete an hour-long run's report)."""
+    replaced as a whole (report.write_all removes a plot it could not draw). stability.md
+    and verdicts.md of runs that did not run them are left, each headed by its own run's
+    command and date (a quick subset must not delete an hour-long run's report)."""
     from ..validate import report, stability, verdicts
 
     os.makedirs(out, exist_ok=True)
@@ -168,11 +153,6 @@ def _write(out, header, rows, stab, verd) -> dict:
             paths[key] = os.path.join(out, f"{key}.md")
             with open(paths[key], "w") as f:
                 f.write("\n".join(header + ["", md(items), ""]))
-    written = [v for k, v in paths.items() if k != "plot_skipped"]
-    family = REPORT_FILES[:3] if rows else ()
-    for path in report.remove_stale(out, family, written):
-        print(f"{PROG}: removed {path} (an earlier run's; this run did not write it)",
-              file=sys.stderr)
     return paths
 
 
