@@ -32,11 +32,10 @@ def _check_out(out: str) -> None:
                          "ending in " + " or ".join(VIDEO_SUFFIXES))
     if os.path.isdir(out):
         raise UsageError(f"--out {out}: is a folder; give a video file name")
-    folder = os.path.dirname(os.path.abspath(out))
-    while not os.path.exists(folder):                # the nearest folder that exists
-        folder = os.path.dirname(folder)
-    if not os.path.isdir(folder) or not os.access(folder, os.W_OK | os.X_OK):
-        raise UsageError(f"--out {out}: cannot write into {folder}")
+    from ..record.files import folder_problem
+    bad = folder_problem(os.path.dirname(os.path.abspath(out)))
+    if bad:
+        raise UsageError(f"--out {out}: cannot write into {bad[0]} ({bad[1]})")
 
 
 def _check_args(args) -> None:
