@@ -11,6 +11,7 @@ import pytest
 import taichi as ti
 
 from crowndemo.core import FLUID, GONE, Numerics, Physics, Simulator
+from crowndemo.core.grid import min_cells, row_reach
 
 L0 = 1.0e-3
 RE_RATIO = 2.1
@@ -60,28 +61,29 @@ class Walker:
 
 CAPACITY = 800
 BIG = {2: 1 << 18, 3: 1 << 24}   # cells enough for a 100 re spread: the side stays re/reach
-SMALL = 64                       # forces the cell side to grow
+SMALL = 64                       # forces the cell side to grow (raised to min_cells in 3D)
+REACHES = [1, 2, 3]              # numerics.cells_per_re: cells of side re/k
 
 
 @pytest.fixture(scope="module")
 def sims():
-    """One simulator (and walker) per (dim, max_cells), reloaded by each test: building a
-    simulator compiles its kernels, which is most of the cost here."""
+    """One simulator (and walker) per (dim, max_cells, cells_per_re), reloaded by each test:
+    building a simulator compiles its kernels, which is most of the cost here."""
     cache = {}
 
-    def get(dim: int, max_cells: int):
-        if (dim, max_cells) not in cache:
+    def get(dim: int, max_cells: int, reach: int):
+        if (dim, max_cells, reach) not in cache:
             physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0,
                               gravity=0.0)
-            sim = Simulator(physics, Numerics(), CAPACITY, max_cells)
-            cache[dim, max_cells] = (sim, Walker(sim), Walker(sim, near=True))
-        return cache[dim, max_cells]
+            sim = Simulator(physics, Numerics(cells_per_re=reach), CAPACITY, max_cells)
+            cache[dim, max_cells, reach] = (sim, Walker(sim), Walker(sim, near=True))
+        return cache[dim, max_cells, reach]
     return get
 
 
 def load(sims, dim: int, max_cells: int, pos: np.ndarray, kind: np.ndarray,
-         near: bool = False):
-    sim, walker, near_walker = sims(dim, max_cells)
+         near: bool = False, reach: int = Numerics().cells_per_re):
+    sim, walker, near_walker = sims(dim, max_cells, reach)
     walker = near_walker if near else walker
     sim.load(pos, np.zeros_like(pos), kind)
     return sim, walker
@@ -148,27 +150,33 @@ CLOUD = {2: dict(n_box=600, box_re=12.0), 3: dict(n_box=700, box_re=7.0)}
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_neighbours_match_brute_force_far_outliers(sims, dim):
-    pos = random_cloud(dim, seed=10 + dim, far_re=100.0, **CLOUD[dim])
+@pytest.mark.parametrize("reach", REACHES)
+def test_neighbours_match_brute_force_far_outliers(sims, dim, reach):
+    # outliers 100 re away (60 re for cells of side re/3): BIG cells still hold the spread at
+    # a cell side of re / reach
+    pos = random_cloud(dim, seed=10 + dim, far_re=100.0 if reach < 3 else 60.0, **CLOUD[dim])
     kind = np.full(len(pos), FLUID, dtype=np.int32)
-    # enough cells for 100 re spread in every axis: the cell side stays re / reach
-    sim, walker = load(sims, dim, BIG[dim], pos, kind)
+    sim, walker = load(sims, dim, BIG[dim], pos, kind, reach=reach)
     sim.grid.build(RE)
-    assert sim.grid.side[None] == pytest.approx(RE / sim.grid.reach, rel=1e-6)
+    assert sim.grid.reach == reach
+    assert sim.grid.side[None] == pytest.approx(RE / reach, rel=1e-6)
     found = check_against_brute_force(sim, walker, as_loaded(sim), kind)
     assert found[len(pos) - 2, len(pos) - 1] and found[len(pos) - 1, len(pos) - 2]
     assert found.sum(axis=1).mean() > 5
 
 
 @pytest.mark.parametrize("dim", [2, 3])
-def test_neighbours_when_cell_side_must_grow(sims, dim):
+@pytest.mark.parametrize("reach", REACHES)
+def test_neighbours_when_cell_side_must_grow(sims, dim, reach):
     pos = random_cloud(dim, seed=20 + dim, far_re=100.0, **CLOUD[dim])
     kind = np.full(len(pos), FLUID, dtype=np.int32)
-    sim, walker = load(sims, dim, SMALL, pos, kind)
+    sim, walker = load(sims, dim, SMALL, pos, kind, reach=reach)
     sim.grid.build(RE)
     side = sim.grid.side[None]
     assert side > 10 * RE, "the spread should force a larger cell side"
-    assert sim.grid.num_cells[None] <= SMALL
+    # a limit under the padded grid's minimum is raised to it, and the side still fits
+    assert sim.grid.max_cells == max(SMALL, min_cells(dim, reach))
+    assert sim.grid.num_cells[None] <= sim.grid.max_cells
     check_against_brute_force(sim, walker, as_loaded(sim), kind)
 
 
@@ -225,7 +233,8 @@ def test_single_and_empty_live_sets(sims):
 
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("radius_l0", [0.5, 0.95, RE_RATIO])
-def test_row_clipped_walk_matches_brute_force(sims, dim, radius_l0):
+@pytest.mark.parametrize("reach", [2, 3])
+def test_row_clipped_walk_matches_brute_force(sims, dim, radius_l0, reach):
     """for_each_near (the collision model's walk, rows clipped to the sphere) finds exactly
     the pairs closer than its radius: the collision distance 0.5 l0, the largest allowed
     (< 1 l0), and re itself; a dense cloud so that close pairs are many."""
@@ -234,8 +243,39 @@ def test_row_clipped_walk_matches_brute_force(sims, dim, radius_l0):
     side = (n ** (1.0 / dim)) * 0.6 * L0          # mean spacing 0.6 l0
     pos = rng.uniform(0.0, side, size=(n, dim))
     kind = np.full(n, FLUID, dtype=np.int32)
-    sim, walker = load(sims, dim, BIG[dim], pos, kind, near=True)
+    sim, walker = load(sims, dim, BIG[dim], pos, kind, near=True, reach=reach)
     sim.grid.build(RE)
     found = check_against_brute_force(sim, walker, as_loaded(sim), kind,
                                       radius=radius_l0 * L0)
     assert found.sum() > 2 * n, "test set-up: too few pairs to test the clipping"
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("reach", REACHES)
+def test_stencil_holds_every_pair_within_re(dim, reach):
+    """The walk's compile-time stencil (``row_reach``): for random points x in a cell of side
+    h = re/k and random y within re of x, y's cell lies in a row the walk visits and within
+    that row's reach along axis 0; and the stencil is no larger than it must be: every cell
+    it visits can hold such a pair (a point pair at the cells' nearest corners)."""
+    rng = np.random.default_rng(60 + 10 * dim + reach)
+    h = 1.0 / reach                                    # re = 1
+    x = rng.uniform(0.0, h, size=(200_000, dim))
+    u = rng.normal(size=(len(x), dim))
+    u *= (rng.uniform(size=(len(x), 1)) ** (1.0 / dim)) / np.linalg.norm(u, axis=1)[:, None]
+    cell = np.floor((x + u) / h).astype(int)           # y = x + u, |u| < re
+    for o in np.unique(cell, axis=0):
+        reach_row = row_reach(tuple(o[1:]), reach)
+        assert reach_row >= 0 and abs(o[0]) <= reach_row, f"cell offset {o} not walked"
+    visited = 0
+    for off in np.ndindex(*([2 * reach + 1] * (dim - 1))):
+        off = tuple(int(v) - reach for v in off)
+        e = row_reach(off, reach)
+        if e < 0:
+            continue
+        visited += 2 * e + 1
+        gap = [max(abs(o) - 1, 0) * h for o in (e,) + off]
+        assert sum(g * g for g in gap) < 1.0, f"row {off} reaches too far ({e})"
+    # the full block less the cells no pair can reach. In 3D for k = 3 those are the cells
+    # with two offsets of +-3 and the third +-2 or +-3 (nearest-corner distance
+    # sqrt(2^2 + 2^2 + 1) h >= 3 h = re): 3 x 8 + 8 = 32 of 343; for k <= 2 none
+    assert visited == {2: {1: 9, 2: 25, 3: 49}, 3: {1: 27, 2: 125, 3: 343 - 32}}[dim][reach]

@@ -146,7 +146,8 @@ NUMERICS_KEYS = {
                            lo=0, lo_incl=True, hi=1_000_000),
     "neighbour_list": Field("bool", "list each fluid particle's neighbours in the density pass "
                             "for the pressure gradient (same results, faster)", default=True),
-    "cells_per_re": Field("int", "cells of side re/k: the neighbour walk visits (2k + 1)^d cells",
+    "cells_per_re": Field("int", "cells of side re/k: the neighbour walk visits the cells of "
+                          "the (2k + 1)^d block around that can hold a neighbour",
                           lo=1, lo_incl=True, hi=3, hi_incl=True),
     "wall_model": Field("choice", "the floor: wall and dummy particle layers, or the analytic "
                         "plane floor (no particles under the floor)", choices=WALL_MODELS),

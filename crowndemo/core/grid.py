@@ -3,8 +3,11 @@
 The grid is rebuilt from scratch whenever positions change: bounds by reduction, cell count per
 cell, a blocked prefix sum that runs on the CPU and GPU archs alike (blocks.py; Taichi's
 PrefixSumExecutor does not run on the CPU), then a scatter into ``order`` (particle indices in
-cell order). Cells have side >= re/k (k = ``cells_per_re``), so every neighbour within re lies
-in the (2k + 1)^d cells around; k = 2 visits fewer candidate pairs than k = 1 (BENCHMARKS.md).
+cell order). Cells have side h >= re/k (k = ``cells_per_re``), so every neighbour within re
+lies within k cells on each axis. The walk visits only the cells of that (2k + 1)^d block that
+can hold a point within re of the particle's own cell (a stencil fixed at compile time: all 125
+for k = 2, 311 of 343 for k = 3), row by row along axis 0, where cells are contiguous in cell
+order. The grid is padded with k empty cells on every side, so a row never needs a bounds test.
 If the live particles spread so far that the cells would not fit in ``max_cells``, the cell side
 grows: the walk stays exact, only more candidate pairs are visited.
 """
@@ -15,13 +18,34 @@ from .blocks import BLOCK, blocks_for, exclusive_scan, groups_for, larger, reduc
 from .state import GONE, ParticleState
 
 
+def row_reach(off, k: int) -> int:
+    """How far along axis 0 the walk's row at cell offset ``off`` (axes 1..d-1) reaches, in
+    cells of side h = re/k: the largest |o_0| such that the cell at (o_0, off) can hold a point
+    within re of a point of the centre cell, sum_m (max(|o_m| - 1, 0) h)^2 < re^2; -1 when no
+    cell of the row can. A larger h (the side grown under the cell limit) only shrinks the true
+    set, so the stencil holds for every h >= re/k."""
+    across = sum(max(abs(int(o)) - 1, 0) ** 2 for o in off)
+    if across >= k * k:
+        return -1
+    reach = 0
+    while reach < k and reach * reach + across < k * k:
+        reach += 1
+    return reach
+
+
+def min_cells(dim: int, cells_per_re: int) -> int:
+    """The fewest cells a grid needs: one cell with its padding and one to spare per axis, so
+    that a growing cell side always ends within the limit."""
+    return (2 * int(cells_per_re) + 3) ** dim
+
+
 @ti.data_oriented
 class CellGrid:
     def __init__(self, state: ParticleState, max_cells: int, cells_per_re: int = 2):
         d = self.dim = state.dim
         self.reach = int(cells_per_re)      # cells of side re/reach; walk (2 reach + 1)^d
         self.state = state
-        self.max_cells = int(max_cells)     # cells allocated
+        self.max_cells = max(int(max_cells), min_cells(d, self.reach))   # cells allocated
         self.cell_limit = ti.field(ti.i32, shape=())   # cells used at most (<= max_cells)
         self.cell_limit[None] = self.max_cells
         self.lo = ti.field(float, d)
@@ -54,7 +78,8 @@ class CellGrid:
     def set_cell_limit(self, cells: int) -> None:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
         grid allocated larger gives the same cells, and results, as one allocated to fit."""
-        self.cell_limit[None] = min(int(cells), self.max_cells)
+        self.cell_limit[None] = max(min(int(cells), self.max_cells),
+                                    min_cells(self.dim, self.reach))
 
     def nbytes(self) -> int:
         from .state import field_nbytes
@@ -99,19 +124,21 @@ class CellGrid:
                 for k in ti.static(range(d)):
                     self.lo[k] = 0.0
                     self.hi[k] = 0.0
+            pad = ti.static(self.reach)    # empty cells on every side (module docstring)
             cells = 1.0
             for k in ti.static(range(d)):
-                cells *= (self.hi[k] - self.lo[k]) / h + 2.0
+                cells *= (self.hi[k] - self.lo[k]) / h + 2.0 + 2.0 * pad
             limit = self.cell_limit[None]
             while cells > limit:
                 h *= ti.max(1.01, (cells / limit) ** (1.0 / d))
                 cells = 1.0
                 for k in ti.static(range(d)):
-                    cells *= (self.hi[k] - self.lo[k]) / h + 2.0
+                    cells *= (self.hi[k] - self.lo[k]) / h + 2.0 + 2.0 * pad
             total = 1
             for k in ti.static(range(d)):
-                self.origin[k] = self.lo[k] - 0.5 * h
-                self.dims[k] = ti.cast(ti.floor((self.hi[k] - self.origin[k]) / h), ti.i32) + 1
+                self.origin[k] = self.lo[k] - (0.5 + pad) * h
+                self.dims[k] = ti.cast(ti.floor((self.hi[k] - self.origin[k]) / h),
+                                       ti.i32) + 1 + pad
                 total *= self.dims[k]
             self.side[None] = h
             self.num_cells[None] = total
@@ -174,10 +201,11 @@ class CellGrid:
     # ---- functions used by the passes ----------------------------------------------------
     @ti.func
     def cell_of(self, x):
+        """The cell of x, kept off the padding (a live particle's cell always is)."""
         c = ti.Vector([0] * self.dim)
         for k in ti.static(range(self.dim)):
             ck = ti.cast(ti.floor((x[k] - self.origin[k]) / self.side[None]), ti.i32)
-            c[k] = ti.min(ti.max(ck, 0), self.dims[k] - 1)
+            c[k] = ti.min(ti.max(ck, self.reach), self.dims[k] - 1 - self.reach)
         return c
 
     @ti.func
@@ -191,8 +219,8 @@ class CellGrid:
     @ti.func
     def for_each_neighbour(self, i, xi, re2, task: ti.template(), acc: ti.template()):
         """Call ``task(i, j, rij, r2, acc)`` for every live j != i with r2 = |rij|^2 < re2,
-        rij = x_j - x_i. Cells have side >= re/reach, so the (2 reach + 1)^d cells around hold
-        every neighbour; rows of cells along axis 0 are contiguous in cell order."""
+        rij = x_j - x_i, at the positions of the last ``build``; re2 at most the square of the
+        ``min_side`` it was given (the stencil of the module docstring holds up to that)."""
         self._walk(i, xi, re2, task, acc, False)
 
     @ti.func
@@ -205,39 +233,54 @@ class CellGrid:
     @ti.func
     def _walk(self, i, xi, re2, task: ti.template(), acc: ti.template(), clip: ti.template()):
         d = ti.static(self.dim)
-        c = self.cell_of(xi)
         k = ti.static(self.reach)
+        c = self.cell_of(xi)
         h = self.side[None]
+        stride = ti.Vector([1] * d)       # of the cell index along each axis
+        for m in ti.static(range(1, d)):
+            stride[m] = stride[m - 1] * self.dims[m - 1]
+        centre = self.linear(c)
         for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
-            row = c
-            inside = True
-            gap2 = 0.0      # squared distance from xi to the row's cells across axis 0
-            for m in ti.static(range(1, d)):
-                row[m] = c[m] + off[m - 1]
-                if row[m] < 0 or row[m] >= self.dims[m]:
-                    inside = False
-                if ti.static(clip and off[m - 1] != 0):
-                    lo = self.origin[m] + row[m] * h
-                    gap = lo - xi[m]                     # the row lies above xi on axis m
-                    if ti.static(off[m - 1] < 0):
-                        gap = xi[m] - (lo + h)           # below
-                    gap2 += ti.max(gap, 0.0) ** 2
-            if inside and gap2 < re2:
-                first = ti.max(c[0] - k, 0)
-                last = ti.min(c[0] + k, self.dims[0] - 1)
-                if ti.static(clip):                      # the sphere's chord along axis 0
-                    half = ti.sqrt(re2 - gap2)
-                    first = ti.max(first, ti.cast(ti.floor((xi[0] - half - self.origin[0]) / h),
-                                                  ti.i32))
-                    last = ti.min(last, ti.cast(ti.floor((xi[0] + half - self.origin[0]) / h),
-                                                ti.i32))
-                if first <= last:
-                    row[0] = first
-                    a = self.linear(row)
-                    for s in range(self.cell_start[a], self.cell_start[a + last - first + 1]):
-                        rij = self.sorted_pos[s] - xi
-                        r2 = rij.dot(rij)
-                        if r2 < re2:
-                            j = self.order[s]
-                            if j != i:
-                                task(i, j, rij, r2, acc)
+            reach = ti.static(row_reach(off, k))
+            if ti.static(reach >= 0):      # rows that cannot hold a neighbour are not compiled
+                first = centre - reach     # the row's first cell
+                for m in ti.static(range(1, d)):
+                    first += off[m - 1] * stride[m]
+                if ti.static(clip):
+                    self._clipped_row(i, xi, re2, c, h, off, first, reach, task, acc)
+                else:
+                    self._row(i, xi, re2, self.cell_start[first],
+                              self.cell_start[first + 2 * reach + 1], task, acc)
+
+    @ti.func
+    def _clipped_row(self, i, xi, re2, c, h, off: ti.template(), first, reach: ti.template(),
+                     task: ti.template(), acc: ti.template()):
+        """The row's cells that reach the sphere of radius sqrt(re2) around xi."""
+        gap2 = 0.0      # squared distance from xi to the row's cells across axis 0
+        for m in ti.static(range(1, self.dim)):
+            if ti.static(off[m - 1] != 0):
+                lo = self.origin[m] + (c[m] + off[m - 1]) * h
+                gap = lo - xi[m]                     # the row lies above xi on axis m
+                if ti.static(off[m - 1] < 0):
+                    gap = xi[m] - (lo + h)           # below
+                gap2 += ti.max(gap, 0.0) ** 2
+        if gap2 < re2:
+            half = ti.sqrt(re2 - gap2)               # the sphere's chord along axis 0
+            lo0 = ti.max(-reach, ti.cast(ti.floor((xi[0] - half - self.origin[0]) / h),
+                                         ti.i32) - c[0])
+            hi0 = ti.min(reach, ti.cast(ti.floor((xi[0] + half - self.origin[0]) / h),
+                                        ti.i32) - c[0])
+            if lo0 <= hi0:
+                self._row(i, xi, re2, self.cell_start[first + reach + lo0],
+                          self.cell_start[first + reach + hi0 + 1], task, acc)
+
+    @ti.func
+    def _row(self, i, xi, re2, begin, end, task: ti.template(), acc: ti.template()):
+        """``task`` for the particles in cell-order slots [begin, end) within reach of xi."""
+        for s in range(begin, end):
+            rij = self.sorted_pos[s] - xi
+            r2 = rij.dot(rij)
+            if r2 < re2:
+                j = self.order[s]
+                if j != i:
+                    task(i, j, rij, r2, acc)

@@ -91,7 +91,7 @@ class Numerics:
     # implementation choices (results equal to float rounding; BENCHMARKS.md has their cost):
     neighbour_list: bool = True     # the density pass lists each fluid particle's neighbours
     #                                 for the pressure gradient (core/neighbours.py)
-    cells_per_re: int = 2           # cells of side re/k, a walk over (2k + 1)^d cells (grid.py)
+    cells_per_re: int = 2           # cells of side re/k, a walk within (2k + 1)^d cells (grid.py)
     # the floor (z = 0): layers of wall and dummy particles, or the analytic plane floor
     # (core/plane_floor.py: their contributions tabulated against the height; no particles)
     wall_model: str = "particles"
