@@ -26,8 +26,8 @@ the screen's size); Esc or closing it stops. Without a display, use --headless -
 
 def _check_out(out: str) -> None:
     """UsageError unless ``out`` is a video file name that can be written."""
-    from ..render.video import VIDEO_SUFFIXES
-    if os.path.splitext(out)[1].lower() not in VIDEO_SUFFIXES:
+    from ..render.video import VIDEO_SUFFIXES, is_video_path
+    if not is_video_path(out):
         raise UsageError(f"--out {out}: the reel is written as H.264 MP4; give a file name "
                          "ending in " + " or ".join(VIDEO_SUFFIXES))
     if os.path.isdir(out):

@@ -2,10 +2,10 @@
 estimates per quality."""
 from __future__ import annotations
 
-import json
 import math
 import os
 
+from .. import strictjson
 from ..config import PresetError
 from ..core.params import ParameterError
 from .common import (Fmt, error)
@@ -72,7 +72,7 @@ def _presets(args) -> int:
         except PresetError as e:
             errors.append(e)
     if args.json:
-        print(json.dumps({"folder": str(folder), "throughput": {
+        print(strictjson.dumps({"folder": str(folder), "throughput": {
             "fluid_particle_steps_per_s": tp.rate, "all_particle_steps_per_s": tp.rate_total,
             "source": tp.source}, "presets": rows}, indent=2))
     else:

@@ -10,10 +10,11 @@ from typing import Callable, List, Optional, Sequence
 
 from ..core.health import InstabilityError
 from ..interrupt import StopRun, stop_if_asked
+from ..strictjson import finite_or_none
 from . import checkpoint as ckpt
 from . import snapshots
 from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike
-from .metadata import MetadataSink, finite_or_none
+from .metadata import MetadataSink
 from .metadata import read as read_metadata
 from .runlog import RunLog
 from .sinks import COMPLETE, INTERRUPTED, unstable

@@ -39,9 +39,14 @@ def even(image: np.ndarray) -> np.ndarray:
     return image[: h - h % 2, : w - w % 2]
 
 
+def is_video_path(path: str) -> bool:
+    """Whether ``path`` names a kind of video file that VideoWriter writes."""
+    return os.path.splitext(path)[1].lower() in VIDEO_SUFFIXES
+
+
 def check_video_path(path: str) -> None:
     """ValueError unless ``path`` names a kind of video file that VideoWriter writes."""
-    if os.path.splitext(path)[1].lower() not in VIDEO_SUFFIXES:
+    if not is_video_path(path):
         raise ValueError(f"{path}: a video file must end in " + " or ".join(VIDEO_SUFFIXES)
                          + " (H.264 MP4)")
 
@@ -125,5 +130,5 @@ def read_video(path: str) -> Iterable[np.ndarray]:
         reader.close()
 
 
-__all__ = ["write_png", "read_image", "even", "check_video_path", "VIDEO_SUFFIXES",
+__all__ = ["write_png", "read_image", "even", "is_video_path", "check_video_path", "VIDEO_SUFFIXES",
            "VideoWriter", "encode_mp4", "encode_gif", "read_video"]
