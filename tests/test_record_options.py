@@ -34,6 +34,24 @@ def test_bad_value_exit_2_before_taichi(option, value, allowed, tmp_path, capsys
     assert not (tmp_path / "rec").exists()
 
 
+@pytest.mark.parametrize("option, value", [("--orbit", "-inf"), ("--fps", "-1e3")])
+def test_dash_value_written_with_a_space_says_to_use_equals(option, value, tmp_path, capsys,
+                                                             no_backend):
+    # argparse reads "-inf" / "-1e3" as an option: --orbit (value optional) leaves it over,
+    # --fps (value needed) finds none; either way the line says how to write it
+    argv = ["record", "quick-2d", "--recordings", str(tmp_path / "rec"), option, value]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert f"goes after '=': {option}={value}" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "rec").exists()
+
+
+def test_unknown_option_gets_no_value_hint(tmp_path, capsys, no_backend):
+    assert main(["record", "quick-2d", "--recordings", str(tmp_path / "rec"), "--bogus"]) == 2
+    err = capsys.readouterr().err
+    assert "unrecognized arguments: --bogus" in err and "'='" not in err
+
+
 def test_values_in_range_are_taken():
     p = argparse.ArgumentParser()
     add_render_options(p)

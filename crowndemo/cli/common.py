@@ -34,9 +34,44 @@ class UsageError(Exception):
     """A command-line mistake found by argparse."""
 
 
+def _looks_numeric(token: str) -> bool:
+    try:
+        float(token)
+    except ValueError:
+        return False
+    return True
+
+
 class Parser(argparse.ArgumentParser):
+    _argv: Sequence[str] = ()
+
+    def parse_args(self, args=None, namespace=None):
+        # on the class: a subcommand's parser reports its own errors
+        Parser._argv = tuple(sys.argv[1:] if args is None else args)
+        return super().parse_args(args, namespace)
+
     def error(self, message):          # one line, no usage dump, no SystemExit
-        raise UsageError(f"{message} (see '{self.prog} --help')")
+        raise UsageError(f"{message}{self._value_hint(message)} (see '{self.prog} --help')")
+
+    def _value_hint(self, message: str) -> str:
+        """argparse reads a value such as "-inf" or "-1e3" as an unknown option, not as the
+        value of the option before it: say how to write it."""
+        argv = list(Parser._argv)
+        prefix = "unrecognized arguments: "
+        if message.startswith(prefix):
+            tokens = message[len(prefix):].split()
+        elif message.endswith(": expected one argument"):
+            tokens = [argv[at + 1] for at in range(len(argv) - 1)
+                      if message.startswith(f"argument {argv[at]}")
+                      or f"/{argv[at]}:" in message]
+        else:
+            return ""
+        for token in tokens:
+            if token.startswith("-") and _looks_numeric(token) and token in argv[1:]:
+                at = argv.index(token, 1)
+                option = argv[at - 1] if argv[at - 1].startswith("--") else "--OPTION"
+                return f"; a value that starts with '-' goes after '=': {option}={token}"
+        return ""
 
 
 class Fmt(argparse.RawDescriptionHelpFormatter):
