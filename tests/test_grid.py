@@ -216,6 +216,31 @@ def test_neighbours_after_reorder(sims, dim):
     check_against_brute_force(sim, walker, before, kind, ids=pid)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_counts_of_an_earlier_build_do_not_linger(sims, dim):
+    """A build clears only the cells the previous build counted particles in (the rest are
+    zero): after a large cloud, a smaller one elsewhere, in the same simulator, has exact
+    neighbours and the cell counts hold exactly its live particles, in the allocated grid
+    too; likewise after every particle moves."""
+    big = random_cloud(dim, seed=50 + dim, far_re=40.0, **CLOUD[dim])
+    sim, walker = load(sims, dim, BIG[dim], big, np.full(len(big), FLUID, dtype=np.int32))
+    sim.grid.build(RE)
+    rng = np.random.default_rng(50 + dim)
+    small = rng.uniform(-3.0 * RE, 3.0 * RE, size=(60, dim)) - 50.0 * RE
+    kind = np.where(rng.uniform(size=60) < 0.2, GONE, FLUID).astype(np.int32)
+    sim, walker = load(sims, dim, BIG[dim], small, kind)
+    for shift in (0.0, 7.3 * RE):       # rebuilt as loaded, then with every particle moved
+        pos = small + shift
+        sim.state.pos.from_numpy(np.concatenate(
+            [pos, np.zeros((sim.state.capacity - len(pos), dim))]).astype(
+                sim.state.pos.to_numpy().dtype))
+        sim.grid.build(RE)
+        live = int((kind != GONE).sum())
+        assert sim.grid.n_live[None] == live
+        assert int(sim.grid.cell_count.to_numpy().sum()) == live
+        check_against_brute_force(sim, walker, as_loaded(sim), kind)
+
+
 def test_single_and_empty_live_sets(sims):
     """One live particle has no neighbours; all parked: nothing is walked."""
     pos = np.array([[0.0, 0.0], [0.5 * RE, 0.0], [3.0, 3.0]])

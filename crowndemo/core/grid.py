@@ -63,6 +63,7 @@ class CellGrid:
         self.num_cells = ti.field(ti.i32, shape=())
         self.n_live = ti.field(ti.i32, shape=())
         self.n_parked = ti.field(ti.i32, shape=())
+        self.n_counted = ti.field(ti.i32, shape=())    # particles the last count placed
         self.cell_count = ti.field(ti.i32, self.max_cells)
         self.cell_start = ti.field(ti.i32, self.max_cells + 1)
         self.block_sum = ti.field(ti.i32, blocks_for(self.max_cells))
@@ -77,7 +78,7 @@ class CellGrid:
         self.particle_cell = ti.field(ti.i32, state.capacity)
         self.rank = ti.field(ti.i32, state.capacity)
         self.order = ti.field(ti.i32, state.capacity)   # particle indices in cell order
-        # positions in cell order, copied at the build: the walk tests distances on this
+        # positions in cell order, written by the build's scatter: the walk tests distances on this
         # contiguous array and looks up j = order[s] only for the pairs within reach (a
         # quarter of the candidates). Positions must not change between a build and a walk.
         self.sorted_pos = ti.Vector.field(d, float, state.capacity)
@@ -102,7 +103,6 @@ class CellGrid:
         if reorder:
             self.state.permute(self.order)
             self._identity_order()
-        self._gather_positions()
 
     # ---- kernels -------------------------------------------------------------------------
     @ti.kernel
@@ -153,8 +153,11 @@ class CellGrid:
     @ti.kernel
     def _sort(self):
         pos, kind = ti.static(self.state.pos, self.state.kind)
-        for c in range(self.num_cells[None]):
-            self.cell_count[c] = 0
+        # cell_count is zero but in the cells the last count placed a particle in
+        for i in range(self.n_counted[None]):
+            c = self.particle_cell[i]
+            if c >= 0:
+                self.cell_count[c] = 0
         for i in range(self.state.n[None]):
             if kind[i] != GONE:
                 c = self.linear(self.cell_of(pos[i]))
@@ -174,6 +177,7 @@ class CellGrid:
         for _ in range(1):
             self.cell_start[cells] = self.n_live[None]
             self.n_parked[None] = 0
+            self.n_counted[None] = self.state.n[None]
         for b in range(blocks_for(cells)):
             run = self.block_sum[b]
             for c in range(b * BLOCK, ti.min(cells, (b + 1) * BLOCK)):
@@ -183,14 +187,11 @@ class CellGrid:
         for i in range(self.state.n[None]):
             c = self.particle_cell[i]
             if c >= 0:
-                self.order[self.cell_start[c] + self.rank[i]] = i
+                slot = self.cell_start[c] + self.rank[i]
+                self.order[slot] = i
+                self.sorted_pos[slot] = pos[i]
             else:
                 self.order[self.n_live[None] + ti.atomic_add(self.n_parked[None], 1)] = i
-
-    @ti.kernel
-    def _gather_positions(self):
-        for s in range(self.n_live[None]):
-            self.sorted_pos[s] = self.state.pos[self.order[s]]
 
     @ti.kernel
     def _identity_order(self):
