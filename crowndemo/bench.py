@@ -28,7 +28,8 @@ Throughput of the full explicit MPS step, measured by `crowndemo bench` (code:
 `crowndemo/bench.py`). The scene is a cube-ish block of water resting in a 3D tank with walls
 (`crowndemo.scenes.hydrostatic_tank(dim=3)`, l0 = 1 mm, re = 2.1 l0, water with viscosity,
 no surface tension). One step is everything `Simulator.step()` does: cell-grid build with the
-re-sort of particles, the predictor (viscosity + gravity), a second grid build, number density
+re-sort of particles, the predictor (viscosity + gravity), the particle collision model
+(pairs closer than 0.5 l0, listed by the predictor's walk), a second grid build, number density
 and pressure, the pressure-gradient corrector (`pmin` form), and the health reduction with its
 read-back to the host that picks the next dt.
 
@@ -37,7 +38,8 @@ read-back to the host that picks the next dt.
 - The first steps are not timed: they compile the kernels (or load them from Taichi's offline
   cache, so a repeat run shows a smaller `compile s`). `compile s` = first step - a normal step.
 - `bytes/particle` = `Simulator.memory_bytes()` / total particles (particle fields, cell grid,
-  neighbour list; allocated for the capacity bucket, `core.step.capacity_bucket`).
+  neighbour list, close-pair list; allocated for the capacity bucket,
+  `core.step.capacity_bucket`).
 
 Sections are appended by `crowndemo bench --record`, newest last.
 """

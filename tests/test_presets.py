@@ -104,7 +104,8 @@ def test_info_preset_text_and_json(capsys):
     assert d["memory_bytes"] > 0 and d["steps_at_U"] == math.ceil(4e-3 / d["dt_s"] - 1e-9) + 16
     assert d["steps"] > d["steps_at_U"] and d["run_seconds_estimate"] > d["run_seconds_at_U"]
     assert d["left_out"] == [] or all(isinstance(s, str) for s in d["left_out"])
-    # the crown presets take the Courant limit on relative speeds (README, "The time step"):
+    # the crown presets take the Courant limit on relative speeds (README, the paragraph of
+    # that name):
     # after contact at 0.3 c relative (the approach limit at the splash's 0.5 c), against
     # 0.5 c for the seed's absolute form, so fewer steps
     assert d["numerics"]["courant_speed"] == "relative"

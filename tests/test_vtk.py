@@ -54,3 +54,9 @@ def test_export_records_first_then_round_trips(tmp_path, capsys):
     assert main(argv[:5]) == 0
     assert "no recording" not in capsys.readouterr().err
     assert vtk.read_pvd(rec / "quick-2d" / "vtk" / "quick-2d.pvd") == entries
+    # an interrupted recording exports what it has and says how to resume it
+    meta.update(complete=False, status="interrupted")
+    (rec / "quick-2d" / "metadata.json").write_text(json.dumps(meta))
+    assert main(argv[:5]) == 0
+    err = capsys.readouterr().err
+    assert "(the recording is interrupted)" in err and "record quick-2d --resume" in err

@@ -1,12 +1,12 @@
 """``crowndemo bench``: particle-steps per second of the full step (BENCHMARKS.md)."""
 from __future__ import annotations
 
-import json
 import os
 import shlex
 import sys
 from typing import Dict, Sequence
 
+from .. import strictjson
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
 from ..config.schema import QUALITIES
@@ -119,7 +119,7 @@ def _finish(args, argv: Sequence[str], results) -> None:
     from .. import bench
 
     if args.json:
-        print(json.dumps(results[0] if len(results) == 1 else results, indent=2))
+        print(strictjson.dumps(results[0] if len(results) == 1 else results))
     else:
         print(bench.text_table(results))
     if args.record:
@@ -183,7 +183,8 @@ def register(sub, common) -> None:
                    help="override a value of --preset (as in crowndemo run); for the tank "
                         "block, a numerics value (numerics.KEY=VALUE)")
     p.add_argument("--max-steps", type=int, metavar="N",
-                   help="stop each --preset run after N steps (a smoke test)")
+                   help="stop each --preset run after N steps, at least 2: the first "
+                        "compiles, the rest are timed (a smoke test)")
     p.add_argument("--record", action="store_true",
                    help="append a section (machine, arch, date, command, table) to BENCHMARKS.md "
                         "at the repository root")

@@ -49,6 +49,7 @@ def _read_meta(path: Path) -> Optional[dict]:
 
 def _export(args) -> int:
     from ..record import METADATA, RecordError, recording_dir, recordings_root, vtk
+    from ..record.sinks import INTERRUPTED
     from ..record.recorder import fingerprint, record_preset
 
     if not args.vtk:
@@ -95,6 +96,9 @@ def _export(args) -> int:
             old.unlink()
     pvd = vtk.export(files, out, r.name)
     state = "" if meta["complete"] else f" (the recording is {meta['status']})"
+    if meta.get("status") == INTERRUPTED:
+        state += (f"; '{PROG} record {r.name} --resume', with the same --quality, --set and "
+                  "--recordings, continues it")
     print(f"{PROG}: wrote {len(files)} frames, t = {meta['frames'][0]['time_s'] * 1e3:g} .. "
           f"{meta['frames'][-1]['time_s'] * 1e3:g} ms, to {out}{state}; open {pvd} in ParaView",
           file=sys.stderr)

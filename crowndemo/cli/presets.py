@@ -22,9 +22,11 @@ The presets are the YAML files in presets/ at the repository root ($CROWNDEMO_PR
 another folder). Particle counts come from building each scene with numpy (no kernel runs);
 counts marked ~ are scaled from a build at a coarser spacing. The run time is rough: a first
 run's compile (5 s in 2D, 50 s in 3D, measured; a run whose kernels are in Taichi's cache
-starts in 3-9 s) + (every particle) x steps / rate, with steps = t_end / dt at the drop's
-speed and the rate from the newest CPU section of BENCHMARKS.md; a splash faster than the
-drop takes smaller steps, so real runs take longer.
+starts in 3-9 s) + (every particle) x steps x 0.8 (a crown step's cost per particle against
+the bench's, measured) / the rate of the newest CPU section of BENCHMARKS.md (--rate: another
+machine's). Steps: dt at the drop's speed until it touches the film, then at the splash's
+speed, 0.5 c (with the Courant limit on relative speeds, 0.3 c relative), as measured on crown
+runs. The table's footer names the figures used; `crowndemo info PRESET` shows the steps.
 """
 
 

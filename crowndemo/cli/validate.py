@@ -15,7 +15,7 @@ INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finishe
 
 VALIDATE_EPILOG = """\
 examples:
-  crowndemo validate --quick                     # the quick subset (what make test runs, ~min)
+  crowndemo validate --quick                     # coarse resolutions, stability to 0.4 ms
   crowndemo validate                             # every case, every resolution and setting
   crowndemo validate dam-break-2d laplace-2d     # some cases
   crowndemo validate stability                   # the stiff and extreme cases only
@@ -222,8 +222,8 @@ def _record(result, rows, stab, verd, paths) -> None:
 
     root = repo_root()
     lines = ["# Validation", "",
-             "Written by `crowndemo validate --record` (see the README's Validation section); "
-             "the numbers below are measured, not edited.", "",
+             "Written by `crowndemo validate --record` (see the README's `validate` command "
+             "and its Validation status); the numbers below are measured, not edited.", "",
              f"- machine: {result['machine']}", f"- arch: {result['arch']}, {result['precision']}",
              f"- date: {result['date']}", f"- command: `{result['command']}`", ""]
     if rows:
