@@ -52,6 +52,51 @@ def test_record_stop_and_resume(tmp_path, capsys):
     assert "speed" in capsys.readouterr().err
 
 
+def test_a_fresh_recording_without_rendering_removes_the_old_frames_and_videos(tmp_path,
+                                                                            capsys):
+    """The frames and video of an earlier (rendered) recording would pass for the new one's:
+    play would show them."""
+    argv = ["record", "quick-2d", "--recordings", str(tmp_path), "--quiet"] + SHORT
+    assert main(argv) == 0
+    folder = tmp_path / "quick-2d"
+    assert list(folder.glob("frames/frame_*.png")) and (folder / "video.mp4").is_file()
+    assert main(argv + ["--no-render", "--set", "scene.speed=3"]) == 0
+    assert "replacing the earlier recording" in capsys.readouterr().err
+    assert not list(folder.glob("frames/*.png"))
+    assert not list(folder.glob("video*.mp4")) and not list(folder.glob("preview*.gif"))
+    meta = json.loads((folder / "metadata.json").read_text())
+    assert meta["complete"] and meta["recording_options"]["render"] is False
+
+
+def test_resume_keeps_the_rendering_and_snapshot_options(tmp_path, capsys):
+    """A resumed recording's frames and snapshots must match the first part's: other
+    options are refused with the command that fits, which the interruption printed too."""
+    import shlex
+
+    import imageio.v3 as iio
+
+    from crowndemo.record import snapshots
+    argv = ["record", "quick-2d", "--recordings", str(tmp_path), "--quiet"] + SHORT
+    first = argv + ["--resolution", "320x180", "--all-particles", "--orbit=-2"]
+    assert main(first + ["--max-steps", "5"]) == 0
+    err = capsys.readouterr().err
+    command = err.split("to resume: ")[1].strip()
+    for words in ("--resolution 320x180", "--all-particles", "--orbit=-2"):
+        assert words in command
+    assert main(argv + ["--resume"]) == 2          # the defaults: other options
+    err = capsys.readouterr().err
+    assert "recorded with other options" in err and "resolution 320x180 there, 1280x720 now" in err
+    assert "all-particles True there, False now" in err and command in err
+    assert main(shlex.split(command)[1:] + ["--quiet"]) == 0
+    folder = tmp_path / "quick-2d"
+    meta = json.loads((folder / "metadata.json").read_text())
+    assert meta["complete"] and len(meta["frames"]) == 3
+    sizes = {iio.imread(p).shape[:2] for p in folder.glob("frames/frame_*.png")}
+    assert sizes == {(180, 320)} and len(list(folder.glob("frames/frame_*.png"))) == 3
+    counts = {len(snapshots.read(folder / f["file"])["id"]) for f in meta["frames"]}
+    assert counts == {meta["particles"]["initial"]["total"]}      # walls and dummies in each
+
+
 def test_run_then_reuses_the_session(capsys):
     assert main(["run", "quick-2d", "--then", "quick-2d", "--max-steps", "3", "--json",
                  "--quiet"] + SHORT) == 0

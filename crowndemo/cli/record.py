@@ -32,7 +32,7 @@ snapshots/frame_NNNNN.npz (particles at t = 0 and every frame interval;
 fluid only unless --all-particles), checkpoint.npz (the full state, for --resume) and
 metadata.json (parameters, particle counts, dt, health, wall time, versions, frames, and
 status: running, complete, interrupted or unstable). Recording a preset afresh replaces
-its earlier recording (said on stderr). Files are written under a temporary name and
+its earlier recording, frames and videos included (said on stderr). Files are written under a temporary name and
 renamed, so a file that exists is whole.
 
 Ctrl-C stops after the current step: the frames so far are kept, a checkpoint is saved,
@@ -65,7 +65,70 @@ def _spec(r) -> str:
         return r.label
 
 
-def _resume_command(r, args) -> str:
+# the options that shape a recording's files: a resumed run must keep those of MATCHED
+MATCHED = ("render", "resolution", "colour", "lang", "orbit", "all_particles")
+
+
+def recording_options(args) -> dict:
+    """How the command makes a recording's files (JSON-normal), kept in metadata.json."""
+    return {"render": bool(args.render), "resolution": list(args.resolution),
+            "colour": args.colour, "lang": args.lang, "orbit": float(args.orbit),
+            "fps": float(args.fps), "video": bool(args.video),
+            "all_particles": bool(args.all_particles),
+            "checkpoint_every": int(args.checkpoint_every)}
+
+
+def _option_words(options: dict) -> List[str]:
+    """``options`` (recording_options) as command-line words, defaults left out."""
+    from ..render import RenderSettings
+    d = RenderSettings()
+    words = []
+    if not options["render"]:
+        words.append("--no-render")
+    else:
+        if tuple(options["resolution"]) != tuple(d.resolution):
+            words += ["--resolution", "%dx%d" % tuple(options["resolution"])]
+        if options["colour"] != d.colour:
+            words += ["--colour", options["colour"]]
+        if options["lang"] != d.lang:
+            words += ["--lang", options["lang"]]
+        if options["orbit"] != d.orbit:
+            words.append(f"--orbit={options['orbit']:g}")     # "=": a value may start with -
+        if options["fps"] != d.fps:
+            words += ["--fps", f"{options['fps']:g}"]
+        if not options["video"]:
+            words.append("--no-video")
+    if options["all_particles"]:
+        words.append("--all-particles")
+    if options["checkpoint_every"] != 1:
+        words += ["--checkpoint-every", str(options["checkpoint_every"])]
+    return words
+
+
+def _check_options(folder: Path, saved: Optional[dict], r, args) -> None:
+    """UsageError when --resume is asked with rendering or snapshot options other than the
+    recording's (its frames and snapshots would not match), with the command that fits."""
+    now = recording_options(args)
+    if not isinstance(saved, dict) or not all(k in saved for k in now):
+        return          # a recording made before the options were kept: not checked
+    saved = {**saved, "resolution": list(saved["resolution"])}
+    diff = [f"{k.replace('_', '-')} {_shown(saved[k])} there, {_shown(now[k])} now"
+            for k in MATCHED if saved[k] != now[k]]
+    if diff:
+        raise UsageError(f"{folder} was recorded with other options ({'; '.join(diff)}): its "
+                         f"frames and snapshots would not match. To resume: "
+                         f"{_resume_command(r, args, saved)}")
+
+
+def _shown(value) -> str:
+    if isinstance(value, list):
+        return "x".join(str(v) for v in value)
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _resume_command(r, args, options: Optional[dict] = None) -> str:
+    """The command that resumes ``r``'s recording: these args' preset values and backend,
+    and the recording options (``options``, else the args')."""
     words = [PROG, "record", _spec(r)]
     if args.quality != DEFAULT_QUALITY:
         words += ["--quality", args.quality]
@@ -80,6 +143,7 @@ def _resume_command(r, args) -> str:
         words.append("--single-thread")
     if args.fast_compile:
         words.append("--fast-compile")
+    words += _option_words(options or recording_options(args))
     return " ".join(shlex.quote(w) for w in words + ["--resume"])
 
 
@@ -101,13 +165,20 @@ def _check_folders(root: Path, names: List[str], args) -> None:
 
 def _resume_point(r, folder: Path, args):
     """The checkpoint --resume continues from, checked before Taichi starts (the render sink,
-    made next, would remove the video of the recording)."""
-    from ..record import RecordError
+    made next, would remove the video of the recording), with the recording's options."""
+    from ..record import METADATA, RecordError
+    from ..record.metadata import read
     from ..record.recorder import resume_point
     try:
-        return resume_point(r, folder, args.precision)
+        saved = resume_point(r, folder, args.precision)
     except RecordError as e:
         raise UsageError(str(e)) from None
+    try:
+        meta = read(folder / METADATA) or {}
+    except (OSError, ValueError):
+        meta = {}          # the checkpoint alone decides (resume_point)
+    _check_options(folder, meta.get("recording_options"), r, args)
+    return saved
 
 
 def _record(args) -> int:
@@ -170,7 +241,8 @@ def _record(args) -> int:
                                     session=session, checkpoint_every=args.checkpoint_every,
                                     fluid_only=not args.all_particles, max_steps=args.max_steps,
                                     on_step=progress, on_start=announce, stop=stop, backend=be,
-                                    resume_from=resume_from)
+                                    resume_from=resume_from,
+                                    options=recording_options(args))
             except BaseException as e:
                 for sink in render:           # a run that never started: free the window
                     sink.release()
@@ -263,8 +335,10 @@ def register(sub, common) -> None:
                    help=SET_HELP)
     add_sequence_options(p)
     p.add_argument("--resume", action="store_true",
-                   help="continue from RECORDINGS/PRESET/checkpoint.npz (give the same "
-                        "--quality, --set and --precision as the first time)")
+                   help="continue from RECORDINGS/PRESET/checkpoint.npz with the same "
+                        "--quality, --set, --precision and rendering and snapshot options "
+                        "as the first time (the interruption prints the command; other "
+                        "values are refused)")
     p.add_argument("--recordings", metavar="DIR",
                    help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
                         "./recordings); each preset goes to DIR/PRESET")

@@ -15,6 +15,18 @@ CHECKPOINT = "checkpoint.npz"
 SNAPSHOTS = "snapshots"
 
 
+# what rendering writes into a recording's folder (render/sink.py)
+RENDERED = ("frames/frame_*.png", "video*.mp4", "preview*.gif")
+
+
+def remove_rendered(folder: PathLike) -> int:
+    """Delete the rendered frames, videos and previews in ``folder``; returns how many."""
+    gone = [p for pattern in RENDERED for p in Path(folder).glob(pattern)]
+    for p in gone:
+        p.unlink()
+    return len(gone)
+
+
 def recordings_root() -> Path:
     """``$CROWNDEMO_RECORDINGS``, else ``recordings/`` in the working directory."""
     return Path(os.environ.get("CROWNDEMO_RECORDINGS") or "recordings")

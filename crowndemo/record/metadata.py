@@ -31,8 +31,10 @@ def versions() -> dict:
 
 
 def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoint_every: int,
-          backend=None, fingerprint: Optional[dict] = None) -> dict:
-    """The metadata of a recording as a dict (JSON-ready)."""
+          backend=None, fingerprint: Optional[dict] = None,
+          options: Optional[dict] = None) -> dict:
+    """The metadata of a recording as a dict (JSON-ready). ``options``: how its files are
+    made (rendering, snapshots), which a resumed run must keep (cli/record.py)."""
     s, h = sim.stats, sim.stats.health
     kw = resolved.crown_kwargs()
     kw["numerics"] = asdict(kw["numerics"])
@@ -68,6 +70,7 @@ def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoin
         "frames": log.frames,
         "checkpoint": {"file": CHECKPOINT, "every_frames": checkpoint_every},
         "fingerprint": fingerprint,
+        "recording_options": options,
     })
 
 
@@ -75,15 +78,16 @@ class MetadataSink:
     """Rewrites metadata.json at every frame and at the end."""
 
     def __init__(self, path: PathLike, resolved, scene, sim, log: RunLog, frame_times,
-                 checkpoint_every: int, backend=None, fingerprint: Optional[dict] = None):
+                 checkpoint_every: int, backend=None, fingerprint: Optional[dict] = None,
+                 options: Optional[dict] = None):
         self.path = Path(path)
         self.args = (resolved, scene, sim, log)
         self.frame_times, self.every, self.backend = list(frame_times), checkpoint_every, backend
-        self.fingerprint = fingerprint
+        self.fingerprint, self.options = fingerprint, options
 
     def write(self, status: str) -> dict:
         data = build(*self.args, status, self.frame_times, self.every, self.backend,
-                     self.fingerprint)
+                     self.fingerprint, self.options)
         atomic_write_json(self.path, data)
         return data
 
@@ -95,12 +99,17 @@ class MetadataSink:
 
 
 def read(path: PathLike) -> Optional[dict]:
-    """metadata.json as a dict; None when there is none."""
+    """metadata.json as a dict; None when there is none; ValueError when it is not a JSON
+    object."""
     path = Path(path)
     if not path.is_file():
         return None
     with open(path, encoding="utf-8") as f:
-        return json.load(f)
+        data = json.load(f)
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: not a recording's metadata (a JSON {type(data).__name__}, "
+                         "not an object)")
+    return data
 
 
 __all__ = ["MetadataSink", "build", "read", "versions"]

@@ -13,7 +13,7 @@ from ..interrupt import StopRun, stop_if_asked
 from ..strictjson import finite_or_none
 from . import checkpoint as ckpt
 from . import snapshots
-from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike
+from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike, remove_rendered
 from .metadata import MetadataSink
 from .metadata import read as read_metadata
 from .runlog import RunLog
@@ -130,8 +130,8 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
                   *, session=None, checkpoint_every: int = 1, fluid_only: bool = True,
                   max_steps: Optional[int] = None, on_step: Optional[Callable] = None,
                   on_start: Optional[Callable] = None, stop=None,
-                  backend=None, resume_from: Optional[ckpt.Checkpoint] = None
-                  ) -> RecordResult:
+                  backend=None, resume_from: Optional[ckpt.Checkpoint] = None,
+                  options: Optional[dict] = None) -> RecordResult:
     """Record ``resolved`` (a config.Resolved) into ``out_dir``; returns how it ended.
 
     ``sinks_extra`` are frame sinks called after the snapshot and before the checkpoint and
@@ -145,7 +145,10 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     written so far are kept. A sink that fails to close (the video encoder) is returned in
     ``close_error``, not raised (Ctrl-C is, once every sink is closed); a run that had
     completed then ends "failed: ...". ``on_step(sim)`` runs after every step (progress),
-    ``on_start(result)`` once the simulator is loaded.
+    ``on_start(result)`` once the simulator is loaded. ``options``: how the files are made
+    (the command's rendering and snapshot options), kept in metadata.json for ``--resume``.
+    A fresh recording first removes an earlier one's snapshots, checkpoint, metadata, frames
+    and videos.
     """
     from .. import backend as backend_mod
     from ..control import Session
@@ -160,10 +163,12 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     if resume:
         saved = resume_from or resume_point(resolved, folder, be.precision)
         snapshots.remove_from(folder / SNAPSHOTS, saved.next_frame)   # re-made from here
-    else:
+    else:       # an earlier recording's files would pass for this one's (frames too)
         replaced = snapshots.remove_from(folder / SNAPSHOTS, 0)
         for name in (CHECKPOINT, METADATA):
             (folder / name).unlink(missing_ok=True)
+        if folder.is_dir():
+            remove_rendered(folder)
     folder.mkdir(parents=True, exist_ok=True)
 
     session = session or Session()
@@ -179,7 +184,7 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     checkpoint = ckpt.CheckpointSink(folder / CHECKPOINT, sim, log, print_, checkpoint_every,
                                      start)
     meta = MetadataSink(folder / METADATA, resolved, scene, sim, log, frames, checkpoint_every,
-                        be, print_)
+                        be, print_, options)
     sinks = [snapshots.SnapshotSink(folder, log, fluid_only), *sinks_extra, checkpoint, meta]
     log.start(sim.stats.steps, time.perf_counter() - t0)
     log.stopped_by = None
