@@ -39,6 +39,8 @@ def test_recordings_folder_that_is_a_file_is_refused(tmp_path, capsys):
 
 @pytest.mark.parametrize("text, what", [('{"format": 1, "complete": tr', "cannot read it"),
                                         ("[1, 2]", "not a recording's metadata"),
+                                        ('{"complete": true, "frames": [1]}',
+                                         "not a recording's metadata"),
                                         (b"\xff\xfe{", "cannot read it")])
 def test_metadata_that_is_not_whole_is_named(tmp_path, capsys, text, what):
     meta = tmp_path / "R" / "quick-2d" / "metadata.json"

@@ -25,7 +25,9 @@ exports the frames it has and says how to resume it.
 Writes OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
 data: velocity, pressure, number_density, kind, id; 2D runs get z = 0) and OUT/PRESET.pvd
 (every frame with its time in s): open the .pvd in ParaView. frame_*.vtp files in OUT that
-are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk.
+are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk. All or
+nothing: a snapshot that cannot be read (truncated, overwritten) is named in an error and
+OUT is left as it was.
 With --quality or --set, an existing recording must have been made with the same values.
 """
 
@@ -40,15 +42,23 @@ def _read_meta(path: Path) -> Optional[dict]:
     except (OSError, ValueError) as e:          # JSONDecodeError and UnicodeDecodeError too
         raise UsageError(f"{path}: cannot read it ({e}); allowed: the metadata.json of a "
                          "recording: record it again") from None
-    if meta is not None and not (isinstance(meta, dict) and
-                                 isinstance(meta.get("frames"), list) and "complete" in meta):
-        raise UsageError(f"{path}: not a recording's metadata (no frames list); allowed: the "
-                         "metadata.json of a recording: record it again")
+    if meta is not None and not (isinstance(meta, dict) and _frames_ok(meta.get("frames"))
+                                 and "complete" in meta):
+        raise UsageError(f"{path}: not a recording's metadata (no list of frames with file "
+                         "and time_s); allowed: the metadata.json of a recording: record it "
+                         "again")
     return meta
 
 
+def _frames_ok(frames) -> bool:
+    """A list of frames, each with its file and time."""
+    return isinstance(frames, list) and all(
+        isinstance(f, dict) and isinstance(f.get("file"), str) and
+        isinstance(f.get("time_s"), (int, float)) for f in frames)
+
+
 def _export(args) -> int:
-    from ..record import METADATA, RecordError, recording_dir, recordings_root, vtk
+    from ..record import METADATA, RecordError, recording_dir, recordings_root
     from ..record.sinks import INTERRUPTED
     from ..record.recorder import fingerprint, record_preset
 
@@ -90,12 +100,8 @@ def _export(args) -> int:
                          f"{', '.join(missing[:3])}")
     if not files:
         raise UsageError(f"{folder}: the recording has no frame yet")
-    keep = {f"{f.stem}.vtp" for f in files}
-    for old in out.glob("frame_*.vtp"):
-        if old.name not in keep:
-            old.unlink()
-    pvd = vtk.export(files, out, r.name)
-    state = "" if meta["complete"] else f" (the recording is {meta['status']})"
+    pvd = _write_vtk(files, out, r.name)
+    state = "" if meta["complete"] else f" (the recording is {meta.get('status')})"
     if meta.get("status") == INTERRUPTED:
         state += (f"; '{PROG} record {r.name} --resume', with the same --quality, --set and "
                   "--recordings, continues it")
@@ -103,6 +109,25 @@ def _export(args) -> int:
           f"{meta['frames'][-1]['time_s'] * 1e3:g} ms, to {out}{state}; open {pvd} in ParaView",
           file=sys.stderr)
     return code
+
+
+def _write_vtk(files, out: Path, name: str) -> Path:
+    """vtk.export, all or nothing, then frame_*.vtp in ``out`` not part of it removed;
+    UsageError naming a damaged snapshot (``out`` is left as it was)."""
+    from ..record import vtk
+    from ..record.snapshots import SnapshotError
+
+    try:
+        pvd = vtk.export(files, out, name)
+    except SnapshotError as e:
+        raise UsageError(f"{e}; nothing exported ({out} left as it was); allowed: the "
+                         f"snapshots of a whole recording: record it again ('{PROG} record "
+                         f"{name}', with the same --quality, --set and --recordings)") from None
+    keep = {f"{f.stem}.vtp" for f in files}
+    for old in out.glob("frame_*.vtp"):
+        if old.name not in keep:
+            old.unlink()
+    return pvd
 
 
 def register(sub, common) -> None:

@@ -9,16 +9,29 @@ from .errors import PresetError
 from .loader import display, looks_like_path
 
 
-def read_playlist(path: str) -> List[Tuple[str, str]]:
-    """(preset spec, source such as 'list.txt:3') per entry; PresetError for a missing or
-    empty file or a line with more than one word."""
-    p = Path(path)
-    label = display(p)
+def _lines(p: Path, label: str) -> List[str]:
+    """The playlist's lines; PresetError for a file that cannot be read or is not UTF-8
+    (naming the first line that is not)."""
+    allowed = "a UTF-8 text file, one preset name or path per line"
     try:
-        lines = p.read_text(encoding="utf-8").splitlines()
+        data = p.read_bytes()
     except OSError as e:
         raise PresetError(label, None, why=f"cannot read the playlist ({e.strerror})",
-                          allowed="a text file, one preset name or path per line") from None
+                          allowed=allowed) from None
+    try:
+        return data.decode("utf-8").splitlines()
+    except UnicodeDecodeError as e:
+        no = data.count(b"\n", 0, e.start) + 1
+        raise PresetError(f"{label}:{no}", None, why=f"not UTF-8 text (byte "
+                          f"0x{data[e.start]:02x})", allowed=allowed) from None
+
+
+def read_playlist(path: str) -> List[Tuple[str, str]]:
+    """(preset spec, source such as 'list.txt:3') per entry; PresetError for a missing,
+    unreadable, non-UTF-8 or empty file or a line with more than one word."""
+    p = Path(path)
+    label = display(p)
+    lines = _lines(p, label)
     out = []
     for no, line in enumerate(lines, 1):
         text = line.split("#", 1)[0].strip()

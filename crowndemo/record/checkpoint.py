@@ -23,6 +23,7 @@ from ..core.step import RunStats
 from .files import PathLike, atomic_write
 from .runlog import RunLog
 from .sinks import INTERRUPTED
+from .snapshots import NPZ_ERRORS, open_npz, why
 
 FORMAT = 1
 
@@ -84,24 +85,34 @@ def save(path: PathLike, saved: dict, log: RunLog, next_frame: int, fingerprint:
 
 
 def load(path: PathLike) -> Checkpoint:
+    """The checkpoint in ``path``; CheckpointError naming the file when there is none, it is
+    damaged (truncated, overwritten) or of another format."""
     path = Path(path)
     if not path.is_file():
         raise CheckpointError(f"{path}: no checkpoint to resume from")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            meta = json.loads(str(z["meta"]))
-            if meta.get("format") != FORMAT:
-                raise CheckpointError(f"{path}: checkpoint format {meta.get('format')!r}; this "
-                                      f"version reads format {FORMAT}")
-            particles = {k.split("/", 1)[1]: z[k] for k in z.files if k.startswith("particles/")}
-            saved = {"particles": particles, "health_counters": z["health_counters"],
-                     "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"],
-                                           meta["log"]),
-                     "n_fluid": meta["n_fluid"]}
-    except (OSError, KeyError, ValueError) as e:
-        if isinstance(e, CheckpointError):
-            raise
-        raise CheckpointError(f"{path}: unreadable checkpoint ({e})") from None
+        return _read(path)
+    except CheckpointError:
+        raise
+    except NPZ_ERRORS + (TypeError,) as e:
+        raise CheckpointError(f"{path}: unreadable checkpoint ({why(e)})") from None
+
+
+def _read(path: Path) -> Checkpoint:
+    with open_npz(path) as z:
+        meta = json.loads(str(z["meta"]))
+        if not isinstance(meta, dict):
+            raise ValueError("its meta entry is not a JSON object")
+        if meta.get("format") != FORMAT:
+            raise CheckpointError(f"{path}: checkpoint format {meta.get('format')!r}; this "
+                                  f"version reads format {FORMAT}")
+        for k in ("stats", "log", "fingerprint"):
+            if not isinstance(meta.get(k), dict):
+                raise ValueError(f"its meta entry has no {k}")
+        particles = {k.split("/", 1)[1]: z[k] for k in z.files if k.startswith("particles/")}
+        saved = {"particles": particles, "health_counters": z["health_counters"],
+                 "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"], meta["log"]),
+                 "n_fluid": meta["n_fluid"]}
     return Checkpoint(saved, RunLog.from_json(meta["log"]), int(meta["next_frame"]),
                       meta["fingerprint"])
 

@@ -7,6 +7,8 @@ only by default (parked particles are counted in metadata.json instead).
 """
 from __future__ import annotations
 
+import zipfile
+import zlib
 from pathlib import Path
 from typing import Dict
 
@@ -17,6 +19,13 @@ from .files import SNAPSHOTS, PathLike, atomic_write, frame_name
 from .runlog import RunLog
 
 FIELDS = ("pos", "vel", "pressure", "number_density", "kind", "id")
+SCALARS = ("time", "index")
+# what reading a damaged .npz raises (a truncated archive, a bad CRC, a stray .npy or text)
+NPZ_ERRORS = (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, zlib.error)
+
+
+class SnapshotError(ValueError):
+    """A snapshot file that cannot be read or is not a snapshot (one line, naming it)."""
 
 
 class SnapshotSink:
@@ -45,12 +54,51 @@ def write(path: PathLike, snap: Dict[str, np.ndarray], index: int, time: float,
         f, time=np.float64(time), index=np.int64(index), **arrays))
 
 
+def open_npz(path: PathLike):
+    """``np.load`` of an .npz archive; ValueError, short, when the file is none (truncated,
+    or overwritten by something else), where numpy would talk of pickles."""
+    with open(path, "rb") as f:
+        if not zipfile.is_zipfile(f):
+            raise ValueError("not an .npz archive: truncated or another kind of file")
+    return np.load(path, allow_pickle=False)
+
+
+def why(e: BaseException) -> str:
+    """What went wrong reading an .npz file, in a few words."""
+    text = getattr(e, "strerror", None) or str(e) or type(e).__name__
+    damaged = isinstance(e, (zipfile.BadZipFile, zlib.error, EOFError))
+    return f"damaged data: {text}" if damaged else text
+
+
 def read(path: PathLike) -> Dict[str, np.ndarray]:
-    """A snapshot as a dict of arrays (``time`` and ``index`` as Python numbers)."""
-    with np.load(path, allow_pickle=False) as z:
-        out = {k: z[k] for k in z.files}
-    out["time"], out["index"] = float(out["time"]), int(out["index"])
+    """A snapshot as a dict of arrays (``time`` and ``index`` as Python numbers);
+    SnapshotError naming the file when it is damaged or not a snapshot."""
+    try:
+        with open_npz(path) as z:
+            out = {k: z[k] for k in z.files}
+        _check(out)
+        out["time"], out["index"] = float(out["time"]), int(out["index"])
+    except NPZ_ERRORS as e:
+        raise SnapshotError(f"{path}: cannot read the snapshot ({why(e)})") from None
     return out
+
+
+def _check(snap: Dict[str, np.ndarray]) -> None:
+    """ValueError unless ``snap`` holds every field: N x 2 or N x 3 positions and velocities,
+    one value per particle of the rest, one number for time and index."""
+    missing = [k for k in FIELDS + SCALARS if k not in snap]
+    if missing:
+        raise ValueError(f"no {', '.join(missing)}")
+    pos = snap["pos"]
+    if pos.ndim != 2 or pos.shape[1] not in (2, 3) or snap["vel"].shape != pos.shape:
+        raise ValueError(f"positions {pos.shape}, velocities {snap['vel'].shape}; "
+                         "expected N x 2 or N x 3 each")
+    bad = [k for k in FIELDS[2:] if snap[k].shape != (len(pos),)]
+    if bad:
+        raise ValueError(f"{', '.join(bad)}: not one value per particle")
+    bad = [k for k in SCALARS if snap[k].size != 1]
+    if bad:
+        raise ValueError(f"{', '.join(bad)}: not one number")
 
 
 def remove_from(folder: PathLike, first: int = 0) -> int:
@@ -63,4 +111,5 @@ def remove_from(folder: PathLike, first: int = 0) -> int:
     return gone
 
 
-__all__ = ["SnapshotSink", "write", "read", "remove_from", "FIELDS"]
+__all__ = ["SnapshotSink", "SnapshotError", "write", "read", "open_npz", "remove_from",
+           "FIELDS", "NPZ_ERRORS"]

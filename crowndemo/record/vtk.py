@@ -7,6 +7,9 @@ positions and velocities get a zero third component. Floats keep the snapshot's 
 """
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Dict, List, Sequence, Tuple
@@ -116,19 +119,48 @@ def read_pvd(path: PathLike) -> List[Tuple[float, str]]:
 
 
 def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str) -> Path:
-    """Each snapshot .npz -> out_dir/frame_NNNNN.vtp, and out_dir/NAME.pvd; returns the .pvd."""
+    """Each snapshot .npz -> out_dir/frame_NNNNN.vtp, and out_dir/NAME.pvd; returns the .pvd.
+    All or nothing: the files are written into a temporary folder inside ``out_dir`` and moved
+    into place (the .pvd last) once every frame is written, so a damaged snapshot
+    (snapshots.SnapshotError) or a full disk leaves ``out_dir`` as it was, or absent."""
+    out = Path(out_dir)
+    made = _first_missing(out)
+    out.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=".export.", dir=out))
+    try:
+        names = _write_all(snapshot_files, tmp, name)
+        for n in names:
+            os.replace(tmp / n, out / n)
+    except BaseException:
+        if made is not None:
+            shutil.rmtree(made, ignore_errors=True)
+        raise
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return out / names[-1]
+
+
+def _write_all(snapshot_files: Sequence[PathLike], folder: Path, name: str) -> List[str]:
+    """Every frame's .vtp and the .pvd into ``folder``; their names, the .pvd last."""
     from .snapshots import read as read_snapshot
 
-    out = Path(out_dir)
     entries = []
     for f in snapshot_files:
         snap = read_snapshot(f)
         vtp = f"{Path(f).stem}.vtp"
-        write(out / vtp, snap, snap["time"])
+        write(folder / vtp, snap, snap["time"])
         entries.append((snap["time"], vtp))
-    pvd = out / f"{name}.pvd"
-    write_pvd(pvd, entries)
-    return pvd
+    write_pvd(folder / f"{name}.pvd", entries)
+    return [vtp for _, vtp in entries] + [f"{name}.pvd"]
+
+
+def _first_missing(folder: Path):
+    """The outermost of ``folder`` and its parents that does not exist yet (None: it exists),
+    to remove again when an export fails."""
+    missing = None
+    while not folder.exists() and folder != folder.parent:
+        missing, folder = folder, folder.parent
+    return missing
 
 
 __all__ = ["write", "read", "write_pvd", "read_pvd", "export"]
