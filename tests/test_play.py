@@ -1,5 +1,7 @@
 """The booth loop: `crowndemo play --headless` over recordings made here from a few frames."""
 import json
+import os
+import shutil
 
 import numpy as np
 import pytest
@@ -152,3 +154,97 @@ def test_window_needs_an_x_server(recordings, tmp_path, monkeypatch, capsys):
     err = capsys.readouterr().err
     assert "crowndemo: error: cannot open a window on DISPLAY :99 (no X server answers" in err
     assert err.rstrip().endswith("use --headless --out FILE.mp4 to play into a video file")
+
+
+@pytest.mark.parametrize("option, value, allowed", [
+    ("--fps", "nan", "from 0.1 to 240"), ("--fps", "inf", "from 0.1 to 240"),
+    ("--fps", "1e-9", "from 0.1 to 240"), ("--fps", "0", "from 0.1 to 240"),
+    ("--fps", "1000", "from 0.1 to 240"), ("--card-seconds", "nan", "from 0 to 60"),
+    ("--card-seconds", "inf", "from 0 to 60"), ("--card-seconds", "-1", "from 0 to 60"),
+    ("--card-seconds", "61", "from 0 to 60")])
+def test_fps_and_card_seconds_out_of_range(recordings, tmp_path, capsys, option, value,
+                                           allowed):
+    """Refused when parsed, with the range: not a traceback from round() or ffmpeg after the
+    recordings are read (NaN, inf, a rate ffmpeg cannot write), nor a reel of 1000 fps."""
+    out = tmp_path / "reel.mp4"
+    assert play(recordings, out, f"{option}={value}") == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"crowndemo: error: argument {option}: '{value}': allowed: a number "
+                          f"{allowed} (") and err.count("\n") == 1
+    assert not out.exists()
+
+
+def test_fps_and_card_seconds_at_the_ends_of_their_ranges(recordings, tmp_path):
+    out = tmp_path / "reel.mp4"
+    assert play(recordings, out, "red", "--fps", "0.1", "--card-seconds", "0") == 0
+    assert len(list(read_video(str(out)))) == 3                    # no title card
+    assert play(recordings, out, "green", "--fps", "240", "--card-seconds", "0.05") == 0
+    assert len(list(read_video(str(out)))) == 12 + 2               # 0.05 s at 240 fps
+
+
+def test_help_gives_the_ranges(capsys):
+    assert main(["play", "--help"]) == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "--fps FPS frames per second, 0.1 to 240 (default: 12)" in help_text
+    assert "how long each title card shows, 0 to 60 seconds; 0: no cards (default: 3)" \
+        in help_text
+
+
+def test_out_may_not_be_a_recordings_own_video(recordings, tmp_path, capsys):
+    """The reel written over a recording's video would replace the recording (played from its
+    frames, or played next time as that recording): refused, whether played or not."""
+    red, broken = recordings / "red", recordings / "broken"
+    (red / "reel.mp4").symlink_to(red / "video.mp4")
+    before = {p: p.read_bytes() for p in (red / "video.mp4", broken / "video.partial.mp4")}
+    (recordings / "green" / "video.mp4").unlink()                   # --no-video: frames only
+    for out, shown in [(red / "video.mp4", red), (red / "frames" / ".." / "video.mp4", red),
+                       (red / "reel.mp4", red), (broken / "video.partial.mp4", broken),
+                       (recordings / "green" / "video.mp4", recordings / "green")]:
+        for names in ([], ["red"]):
+            assert play(recordings, out, *names) == 2
+            err = capsys.readouterr().err
+            assert err == f"crowndemo: error: --out {out}: is the recording {shown}'s own " \
+                          f"video ({os.path.basename(os.path.realpath(out))}): the reel " \
+                          "would replace it; give a file outside the recordings' folders\n"
+    assert {p: p.read_bytes() for p in before} == before
+    assert not (recordings / "green" / "video.mp4").exists()
+    (red / "reel.mp4").unlink()
+    assert play(recordings, red / "reel.mp4", "red") == 0          # another name is fine
+
+
+def make_frameless(root, name):
+    """A recording made with --no-render: metadata.json (and snapshots), no frames or video."""
+    d = make_recording(root, name, (0, 0, 0), 1)
+    shutil.rmtree(d / "frames")
+    (d / "video.mp4").unlink()
+    return d
+
+
+def test_recordings_without_frames(recordings, tmp_path, monkeypatch, capsys):
+    only = tmp_path / "dry"
+    make_frameless(only, "drop")
+    make_frameless(only, "splash")
+    assert play(only, tmp_path / "x.mp4") == 2
+    err = capsys.readouterr().err
+    assert err == f"crowndemo: error: the recordings in {only}/ (drop, splash) have no frames " \
+                  "(recorded with --no-render); record one again without --no-render to " \
+                  f"play it, e.g. 'crowndemo record drop --recordings {only}' (with the " \
+                  "--quality and --set it was made with)\n"
+    monkeypatch.setenv("CROWNDEMO_RECORDINGS", str(only))          # the default: no option
+    assert main(["play", "--headless", "--out", str(tmp_path / "x.mp4")]) == 2
+    assert "e.g. 'crowndemo record drop' (with" in capsys.readouterr().err
+    assert play(only, tmp_path / "x.mp4", "drop") == 2             # named
+    assert f"{only / 'drop'}: no frames (recorded with --no-render); record it again " \
+           "without --no-render to play it\n" in capsys.readouterr().err
+    # beside recordings that play: skipped with a warning, as an incomplete one is
+    make_frameless(recordings, "dry")
+    out = tmp_path / "reel.mp4"
+    assert play(recordings, out) == 0
+    err = capsys.readouterr().err
+    assert "crowndemo: warning: recording dry has no frames (recorded with --no-render); " \
+           "skipping it (record it again without --no-render to play it)\n" in err
+    assert "broken is incomplete; skipping" in err
+    card = round(CARD_SECONDS * FPS)
+    assert len(list(read_video(str(out)))) == (card + 2) + (card + 3)   # green, red
+    assert play(recordings, recordings / "dry" / "video.mp4") == 2     # would make it play
+    assert not (recordings / "dry" / "video.mp4").exists()

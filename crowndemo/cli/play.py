@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import shlex
 import sys
 
 from .common import PROG, Fmt, UsageError, start_backend
@@ -18,7 +19,9 @@ A recording is a folder RECORDINGS/NAME (see 'crowndemo record'; RECORDINGS: --r
 $CROWNDEMO_RECORDINGS, else ./recordings) with frames/frame_*.png or video.mp4. Each is
 preceded by a title card (the preset's title and description). A recording whose
 metadata.json does not say "status": "complete" (without metadata: that has no video.mp4)
-is skipped with a warning; --partial plays it with an "incomplete" marker.
+is skipped with a warning; --partial plays it with an "incomplete" marker. One recorded with
+--no-render (metadata.json, no frames) has nothing to play: skipped with a warning too.
+--out may not be a recording's own video (RECORDINGS/NAME/video.mp4): the reel would replace it.
 The window opens at the top-left corner at --resolution (GGUI has no full-screen mode: give
 the screen's size); Esc or closing it stops. Without a display, use --headless --out.
 """
@@ -38,13 +41,33 @@ def _check_out(out: str) -> None:
         raise UsageError(f"--out {out}: cannot write into {bad[0]} ({bad[1]})")
 
 
+def _check_not_a_recording_file(out: str, folders) -> None:
+    """UsageError when ``out`` is a video of one of the recordings in ``folders``."""
+    from ..render.player import owner_of
+    hit = owner_of(out, folders)
+    if hit:
+        folder, name = hit
+        raise UsageError(f"--out {out}: is the recording {folder}'s own video ({name}): the "
+                         "reel would replace it; give a file outside the recordings' folders")
+
+
+def _no_recordings(root: str, frameless) -> str:
+    """Why there is nothing to play in ``root``, and how to record something that plays."""
+    from ..record import recordings_root
+    from ..render.player import NO_FRAMES
+    if not frameless:
+        return f"no recordings in {root}/ (make one with '{PROG} record PRESET')"
+    where = "" if root == os.fspath(recordings_root()) else f" --recordings {shlex.quote(root)}"
+    return (f"the recordings in {root}/ ({', '.join(frameless)}) have {NO_FRAMES}; record "
+            f"one again without --no-render to play it, e.g. '{PROG} record {frameless[0]}"
+            f"{where}' (with the --quality and --set it was made with)")
+
+
 def _check_args(args) -> None:
     """UsageError for a bad option; fills in the defaults that depend on others."""
     from ..record import recordings_root
     if args.loops is not None and args.loops < 1:
         raise UsageError(f"--loops {args.loops}: must be >= 1")
-    if args.fps <= 0 or args.card_seconds < 0:
-        raise UsageError("--fps must be > 0 and --card-seconds >= 0")
     if args.headless and not args.out:
         raise UsageError("--headless needs --out FILE.mp4")
     if args.out and not args.headless:
@@ -63,14 +86,20 @@ def _play(args, argv) -> int:
     from ..render.window import check_available
 
     _check_args(args)
+    frameless = [] if args.recordings else player.frameless_recordings(args.dir)
     names = args.recordings or player.list_recordings(args.dir)
     if not names:
-        raise UsageError(f"no recordings in {args.dir}/ (make one with '{PROG} record PRESET')")
+        raise UsageError(_no_recordings(args.dir, frameless))
     try:
-        chosen = player.select([player.open_recording(n, args.dir) for n in names],
-                               args.partial)
+        found = [player.open_recording(n, args.dir) for n in names]
     except player.PlayError as e:
         raise UsageError(str(e)) from None
+    if args.headless:                  # every recording's video stays, played or not
+        here = player.list_recordings(args.dir) + frameless
+        _check_not_a_recording_file(args.out, [r.path for r in found]
+                                    + [os.path.join(args.dir, n) for n in here])
+    player.warn_frameless(frameless)
+    chosen = player.select(found, args.partial)
     if not chosen:
         raise UsageError("every recording named is incomplete (--partial plays them)")
     if not args.headless:
@@ -91,8 +120,8 @@ def _play(args, argv) -> int:
 
 def register(sub, common) -> None:
     from ..render.captions import LANGS
-    from ..render.options import parse_resolution
-    from ..render.player import CARD_SECONDS
+    from ..render.options import FPS_RANGE, bounded, parse_resolution
+    from ..render.player import CARD_RANGE, CARD_SECONDS
     from ..render.renderer import BOOTH_RESOLUTION
 
     p = sub.add_parser("play", parents=common, formatter_class=Fmt, epilog=PLAY_EPILOG,
@@ -115,10 +144,12 @@ def register(sub, common) -> None:
                    help="title-card language; ja needs a CJK font (default: en)")
     p.add_argument("--partial", action="store_true",
                    help="also play incomplete recordings, marked as such")
-    p.add_argument("--fps", type=float, default=12.0,
-                   help="frames per second (default: %(default)g)")
-    p.add_argument("--card-seconds", type=float, default=CARD_SECONDS,
-                   help="how long each title card shows (default: %(default)g)")
+    p.add_argument("--fps", type=bounded(*FPS_RANGE, "frames per second"), default=12.0,
+                   help="frames per second, %g to %g (default: %%(default)g)" % FPS_RANGE)
+    p.add_argument("--card-seconds", type=bounded(*CARD_RANGE, "seconds; 0: no title cards"),
+                   default=CARD_SECONDS,
+                   help="how long each title card shows, %g to %g seconds; 0: no cards "
+                        "(default: %%(default)g)" % CARD_RANGE)
     p.add_argument("--resolution", type=parse_resolution, default=BOOTH_RESOLUTION,
                    metavar="WxH", help="window or video size (default: %dx%d)"
                    % BOOTH_RESOLUTION)

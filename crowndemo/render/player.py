@@ -6,9 +6,12 @@ and usually ``metadata.json``. It is complete when its metadata says ``"status":
 (or ``"complete": true``); without metadata, when ``video.mp4`` exists (the frame sink names a
 video of an unfinished recording ``video.partial.mp4``). Incomplete recordings are skipped
 with a warning, or with ``partial=True`` played with an "incomplete" marker on every frame.
+A folder with metadata.json but no frames or video (recorded with --no-render) has nothing to
+play: it is skipped with a warning too.
 """
 from __future__ import annotations
 
+import fnmatch
 import glob
 import itertools
 import json
@@ -27,6 +30,11 @@ from .window import close_window, open_window
 
 DEFAULT_ROOT = "recordings"
 CARD_SECONDS = 3.0
+# --card-seconds: 0 shows no title cards; a minute is already far longer than a booth card
+# needs, and a huge or non-finite one never gets to the recordings (or cannot be counted).
+CARD_RANGE = (0.0, 60.0)
+OWN_VIDEOS = "video*.mp4"         # the videos the frame sink writes into a recording's folder
+NO_FRAMES = "no frames (recorded with --no-render)"
 MARKER = {"en": "INCOMPLETE RECORDING", "ja": "未完了の記録"}
 
 
@@ -107,7 +115,9 @@ def open_recording(spec: str, root: str = DEFAULT_ROOT) -> Recording:
         vid = next((os.path.join(path, n) for n in names
                     if os.path.isfile(os.path.join(path, n))), None)
         if vid is None:
-            raise PlayError(f"{path}: no frames (frames/frame_*.png) and no video.mp4")
+            why = (f"{NO_FRAMES}; record it again without --no-render to play it" if meta
+                   else "no frames (frames/frame_*.png) and no video.mp4")
+            raise PlayError(f"{path}: {why}")
     title, description = _preset_texts(name, meta)
     return Recording(name, path, frames, vid, complete, title, description, meta)
 
@@ -118,7 +128,37 @@ def list_recordings(root: str = DEFAULT_ROOT) -> List[str]:
         return []
     return sorted(n for n in os.listdir(root)
                   if glob.glob(os.path.join(root, n, "frames", "frame_*.png"))
-                  or glob.glob(os.path.join(root, n, "video*.mp4")))
+                  or glob.glob(os.path.join(root, n, OWN_VIDEOS)))
+
+
+def frameless_recordings(root: str = DEFAULT_ROOT) -> List[str]:
+    """The names of the folders under ``root`` with a metadata.json but no frames or video:
+    recordings made with --no-render, which have nothing to play."""
+    if not os.path.isdir(root):
+        return []
+    playable = set(list_recordings(root))
+    return sorted(n for n in os.listdir(root) if n not in playable
+                  and os.path.isfile(os.path.join(root, n, "metadata.json")))
+
+
+def warn_frameless(names: Sequence[str]) -> None:
+    """A warning for each recording skipped for having no frames, as ``select`` warns."""
+    for n in names:
+        print(f"crowndemo: warning: recording {n} has {NO_FRAMES}; skipping it (record it "
+              "again without --no-render to play it)", file=sys.stderr)
+
+
+def owner_of(out: str, folders: Sequence[str]) -> Optional[Tuple[str, str]]:
+    """(the folder, the file's name) when the video file ``out`` (links followed) is one of
+    the videos of the recording in one of ``folders``, there or not yet (a reel written there
+    would replace the recording's video, or be played as the recording); else None. Of a
+    recording's files only its videos are MP4s, the one kind of file --out writes."""
+    target = os.path.realpath(out)
+    for folder in folders:
+        if os.path.dirname(target) == os.path.realpath(folder) and \
+                fnmatch.fnmatch(os.path.basename(target), OWN_VIDEOS):
+            return folder, os.path.basename(target)
+    return None
 
 
 def select(recordings: Sequence[Recording], partial: bool) -> List[Recording]:
@@ -206,6 +246,7 @@ def require_display() -> None:
     require("use --headless --out FILE.mp4 to play into a video file")
 
 
-__all__ = ["Recording", "PlayError", "open_recording", "list_recordings", "select", "reel",
-           "fit", "play_to_file", "play_in_window", "require_display", "DEFAULT_ROOT",
-           "CARD_SECONDS", "MARKER"]
+__all__ = ["Recording", "PlayError", "open_recording", "list_recordings",
+           "frameless_recordings", "warn_frameless", "owner_of", "select", "reel", "fit",
+           "play_to_file", "play_in_window", "require_display", "DEFAULT_ROOT", "CARD_SECONDS",
+           "CARD_RANGE", "MARKER"]
