@@ -51,6 +51,33 @@ def test_preset_values_follow_the_seed():
     assert abs(config.load("3m-drop", "booth").l0 - 3e-4) < 1e-12
 
 
+@pytest.mark.parametrize("name", sorted(SHIPPED))
+def test_shipped_presets_keep_the_seeds_sound_speed(name):
+    """c = 5 U (S8) for every shipped preset at every quality: the slow-drop floor (the fall
+    and capillary speeds, config/resolve.py) does not reach U there."""
+    for quality in config.QUALITIES:
+        r = config.load(name, quality)
+        assert r.scene.get("sound_speed") is None
+        assert r.physics.c == pytest.approx(5.0 * r.speed, rel=1e-12)
+
+
+def test_a_slow_drop_takes_its_sound_speed_from_the_capillary_speed():
+    """At U = 0.5 m/s c = 5 U = 2.5 m/s would let the potential's cohesive stress, 2.25
+    sigma/l0 in 2D at re = 2.1 l0 (README, Validation status), compress the liquid by
+    2.25 sigma / (l0 rho c^2) = 26 %: c is 5 sqrt(2.25 sigma / (rho l0)) instead (4 %), and
+    the run that went unstable at its 6th step with c = 5 U runs."""
+    from crowndemo.core import simulator_for
+    r = config.load("quick-2d", "draft", ["scene.speed=0.5", "scene.t_end=4e-4"])
+    sigma, rho = r.liquid["sigma"], r.liquid["rho"]
+    assert r.physics.c == pytest.approx(5.0 * math.sqrt(2.25 * sigma / (rho * r.l0)), rel=0.01)
+    assert r.physics.c > 2.5 * 5.0 * r.speed
+    scene = r.build_scene()
+    assert scene.physics.c == r.physics.c
+    sim = simulator_for(scene)
+    sim.run(r.t_end)                                  # InstabilityError with c = 5 U
+    assert sim.stats.steps > 20 and sim.stats.peak_max_density_excess < 0.5
+
+
 def test_particle_classes_and_quick_is_quick():
     tp = estimate.throughput()
     booth = estimate.summary(config.load("3m-drop", "booth"), tp)["particles"]

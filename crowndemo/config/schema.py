@@ -112,7 +112,8 @@ SCENE_KEYS = {
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
                   default=True),
     "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
-    "sound_speed": number("artificial sound speed c (default 5 U, S8); above U / max_mach",
+    "sound_speed": number("artificial sound speed c (default 5 U, S8, or 5 x the fall or "
+                          "capillary speed of a slower drop); above U / max_mach",
                           "m/s", 0, 1.0e5),
 }
 
