@@ -22,6 +22,12 @@ def test_help(cmd, capsys):
     (["record", "quick-2d", "--checkpoint-every", "-1"], "--checkpoint-every"),
     (["export", "quick-2d"], "--vtk"),
     (["run", "quick-2d", "--playlist", "/nonexistent/list.txt"], "cannot read the playlist"),
+    # an empty path would quietly mean the default folder
+    (["record", "quick-2d", "--recordings", ""], "--recordings: an empty path"),
+    (["export", "quick-2d", "--vtk", "--out", " "], "--out: an empty path"),
+    (["play", "--recordings", "", "--headless", "--out", "x.mp4"], "--recordings: an empty"),
+    (["sweep", "quick-2d", "--out", ""], "--out: an empty path"),
+    (["run", "quick-2d", "--playlist", ""], "--playlist: an empty path"),
 ])
 def test_mistakes_exit_2(argv, words, capsys):
     assert main(argv) == 2

@@ -236,7 +236,7 @@ def add_sequence_options(p) -> None:
     p.add_argument("--then", action="extend", nargs="+", default=[], metavar="PRESET",
                    help="presets to run afterwards, one after another in this process "
                         "(one compiled simulator per model, reused)")
-    p.add_argument("--playlist", metavar="FILE",
+    p.add_argument("--playlist", type=path_argument, metavar="FILE",
                    help="a file with one preset per line (# comments), run after PRESET and "
                         "--then")
 
@@ -251,6 +251,15 @@ def load_presets(args) -> list:
     if getattr(args, "playlist", None):
         specs += read_playlist(args.playlist)
     return [config.load(spec, quality, args.sets, source) for spec, source in specs]
+
+
+def path_argument(text: str) -> str:
+    """argparse type of a file or folder option: an empty value is refused rather than taken
+    for the default, which would write somewhere the user did not name."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path; allowed: a path (leave the option "
+                                         "out for its default)")
+    return text
 
 
 def require_folder(option: str, folder, shown=None) -> None:

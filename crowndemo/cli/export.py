@@ -7,7 +7,7 @@ from typing import Optional
 
 from ..config import QUALITIES
 from .common import PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError, load_preset, \
-    require_folder, start_backend
+    path_argument, require_folder, start_backend
 from .record import _recordings_option
 
 EXPORT_EPILOG = """\
@@ -138,8 +138,9 @@ def register(sub, common) -> None:
     p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
     p.add_argument("--vtk", action="store_true",
                    help="VTK XML: frame_NNNNN.vtp per frame and PRESET.pvd (the one format)")
-    p.add_argument("--out", metavar="DIR", help="output folder (default: RECORDINGS/PRESET/vtk)")
-    p.add_argument("--recordings", metavar="DIR",
+    p.add_argument("--out", type=path_argument, metavar="DIR",
+                   help="output folder (default: RECORDINGS/PRESET/vtk)")
+    p.add_argument("--recordings", type=path_argument, metavar="DIR",
                    help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
                         "./recordings)")
     p.add_argument("--quality", choices=QUALITIES, default=None,

@@ -5,7 +5,7 @@ import os
 import shlex
 import sys
 
-from .common import PROG, Fmt, UsageError, start_backend
+from .common import PROG, Fmt, UsageError, path_argument, start_backend
 
 PLAY_EPILOG = """\
 examples:
@@ -132,14 +132,15 @@ def register(sub, common) -> None:
     p.add_argument("recordings", nargs="*", metavar="PRESET",
                    help="recordings to play: names under --recordings or folder paths "
                         "(default: all)")
-    p.add_argument("--recordings", dest="dir", metavar="DIR",
+    p.add_argument("--recordings", type=path_argument, dest="dir", metavar="DIR",
                    help="the folder of recordings (default: $CROWNDEMO_RECORDINGS, else "
                         "./recordings)")
     p.add_argument("--loops", type=int, default=None,
                    help="play the list N times (default: forever; 1 with --headless)")
     p.add_argument("--headless", action="store_true",
                    help="no window: write the reel to --out")
-    p.add_argument("--out", metavar="FILE.mp4", help="the video file of --headless")
+    p.add_argument("--out", type=path_argument, metavar="FILE.mp4",
+                   help="the video file of --headless")
     p.add_argument("--lang", choices=LANGS, default="en",
                    help="title-card language; ja needs a CJK font (default: en)")
     p.add_argument("--partial", action="store_true",

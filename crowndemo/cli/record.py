@@ -12,8 +12,8 @@ from typing import List, Optional
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.params import ParameterError
 from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError,
-                     add_sequence_options, load_presets, print_summary, require_folder,
-                     start_backend)
+                     add_sequence_options, load_presets, path_argument, print_summary,
+                     require_folder, start_backend)
 
 RECORD_EPILOG = """\
 examples:
@@ -339,7 +339,7 @@ def register(sub, common) -> None:
                         "--quality, --set, --precision and rendering and snapshot options "
                         "as the first time (the interruption prints the command; other "
                         "values are refused)")
-    p.add_argument("--recordings", metavar="DIR",
+    p.add_argument("--recordings", type=path_argument, metavar="DIR",
                    help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
                         "./recordings); each preset goes to DIR/PRESET")
     p.add_argument("--checkpoint-every", type=int, default=1, metavar="K",

@@ -7,8 +7,8 @@ import shlex
 import sys
 
 from ..config import QUALITIES
-from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, UsageError, load_preset, repo_root,
-                     require_folder, start_backend)
+from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, UsageError, load_preset, path_argument,
+                     repo_root, require_folder, start_backend)
 
 # numbers like -1e-3 are values, not options (argparse alone knows only -1 and -0.5)
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
@@ -170,7 +170,8 @@ def register(sub, common) -> None:
                    help="quality rung (default: draft)")
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help=SET_HELP)
-    p.add_argument("--out", metavar="DIR", help="folder for the map (default: reports/)")
+    p.add_argument("--out", type=path_argument, metavar="DIR",
+                   help="folder for the map (default: reports/)")
     p.add_argument("--record", action="store_true",
                    help="also write docs/regime.md and docs/regime.png (linked from "
                         "VALIDATION.md)")

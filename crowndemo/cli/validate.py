@@ -8,7 +8,8 @@ import platform
 import shlex
 import sys
 
-from .common import PROG, Fmt, UsageError, repo_root, require_folder, start_backend
+from .common import (PROG, Fmt, UsageError, path_argument, repo_root, require_folder,
+                     start_backend)
 
 GROUPS = ("stability", "verdicts")
 INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
@@ -266,7 +267,7 @@ def register(sub, common) -> None:
                    help="base settings only (no {variants})")
     p.add_argument("--quality", choices=QUALITIES, default="draft",
                    help="quality of the verdict runs (default: draft)")
-    p.add_argument("--out", metavar="DIR", default=None,
+    p.add_argument("--out", type=path_argument, metavar="DIR", default=None,
                    help="folder for the reports (default: reports/ at the repository root)")
     p.add_argument("--record", action="store_true",
                    help="rewrite VALIDATION.md at the repository root with the results")
