@@ -49,6 +49,10 @@ def test_record_stop_and_resume(tmp_path, capsys):
     assert "interrupted (max-steps)" in err and "--resume" in err
     meta = json.loads((tmp_path / "quick-2d" / "metadata.json").read_text())
     assert (meta["complete"], meta["status"], meta["steps"]) == (False, "interrupted", 5)
+    # the files the preset extends; the --set overrides are named in the sources instead
+    assert meta["extends_chain"][-1].endswith("quick-2d.yaml") and all(
+        c.endswith(".yaml") for c in meta["extends_chain"])
+    assert meta["parameters"]["sources"]["t_end"]["file"] == "--set"
     assert main(argv + ["--resume", "--json"]) == 0
     meta = json.loads(capsys.readouterr().out)
     assert meta["complete"] and meta["steps"] > 5 and len(meta["frames"]) == 3
