@@ -179,6 +179,7 @@ def test_run_summary_text(capsys):
     for word in ("particles", "simulated", "steps bound by", "health", "wall time",
                  "stopped early"):
         assert word in out, word
+    assert " J/m -> " in out            # a 2D run's energy is per unit depth
 
 
 # ---- bad preset files: one clear error each --------------------------------------------------

@@ -10,7 +10,7 @@ from .. import strictjson
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
 from ..config.schema import QUALITIES
-from .common import PROG, Fmt, Progress, repo_root, start_backend
+from .common import PROG, Fmt, Progress, UsageError, repo_root, start_backend
 
 
 BENCH_EPILOG = """\
@@ -54,18 +54,18 @@ def _bench(args, argv: Sequence[str]) -> int:
     if args.preset:
         return _bench_presets(args, argv)
     if args.quality or args.max_steps is not None:
-        raise ParameterError("--quality/--max-steps", "given",
-                             "only with --preset (the tank block has none)", "command line")
-    numerics = _tank_numerics(args.sets)
-    if numerics and args.compare:
-        raise ParameterError("--set/--compare", "given", "one or the other (--compare sets "
-                             "the numerics of its two variants)", "command line")
+        raise UsageError("--quality and --max-steps apply to --preset runs only (the tank "
+                         "block has neither) (see 'crowndemo bench --help')")
+    if args.sets and args.compare:
+        raise UsageError("--set or --compare, not both: --compare sets the numerics of its "
+                         "two variants (see 'crowndemo bench --help')")
     ns = args.n or list(bench.DEFAULT_NS)
     for n in ns:
         if n < 1:
             raise ParameterError("n", n, "an integer >= 1 (fluid particles)", "command line")
     if args.steps < 1:
         raise ParameterError("steps", args.steps, "an integer >= 1", "command line")
+    numerics = _tank_numerics(args.sets, ns)
     start_backend(args)
 
     def progress(r):
@@ -80,29 +80,56 @@ def _bench(args, argv: Sequence[str]) -> int:
     return 0
 
 
-def _tank_numerics(items: Sequence[str]) -> Dict:
-    """``--set numerics.KEY=VALUE`` for the tank block: values of the core's Numerics (the
-    tank has no other keys), checked by ``Numerics.validate`` before any kernel runs."""
-    from ..config import PresetError, overrides
+def _tank_numerics(items: Sequence[str], ns: Sequence[int]) -> Dict:
+    """``--set numerics.KEY=VALUE`` for the tank block (it has no other keys), checked as a
+    preset's numerics are, before Taichi starts: each key, its type and range
+    (config/schema.py), and a fixed dt against every block's time-step limits."""
+    from ..config import Document, PresetError, overrides, schema
     from ..core.params import Numerics, with_values
 
-    values: Dict = {}
-    # allow_unsafe_dt exists for tests that force an unstable run; no preset can set it
-    known = sorted(k for k in Numerics.__dataclass_fields__ if k != "allow_unsafe_dt")
     for item in items:
         parts, value = overrides.parse(item)
-        if len(parts) != 2 or parts[0] != "numerics" or parts[1] not in known:
+        if len(parts) != 2 or parts[0] != "numerics":
             raise PresetError(overrides.SOURCE, ".".join(parts), value,
                               "not a numerics key: the tank block takes numerics.KEY only "
                               "(a preset's other keys need --preset)",
-                              "numerics." + ", numerics.".join(known))
-        values[parts[1]] = value
-    try:
-        with_values(Numerics(), **values).validate()
+                              "numerics." + ", numerics.".join(schema.NUMERICS_KEYS))
+    # merged as a preset's --set layer: a later one wins, an empty VALUE restores the default
+    doc = overrides.apply(Document("bench", None, "the tank block", {}, {}), items)
+    given = doc.data.get("numerics", {})
+    # the schema's own check of a preset's numerics mapping (unknown keys, types, ranges)
+    checked = schema.check_numerics(given, doc)
+    values = {k: checked[k] for k in given}
+    try:            # the core's own checks (the schema's ranges make these pass)
+        numerics = with_values(Numerics(), **values).validate()
     except ParameterError as e:
-        raise PresetError(overrides.SOURCE, "numerics." + e.key, e.value, "out of range",
-                          e.allowed) from None
+        raise PresetError(overrides.SOURCE, "numerics." + e.key, e.value,
+                          "refused by the solver", e.allowed) from None
+    for n in ns:
+        _check_fixed_dt(numerics, n)
     return values
+
+
+def _check_fixed_dt(numerics, n: int) -> None:
+    """A fixed dt must keep the time-step limits of the block of ``n`` (its depth sets the
+    speed and the sound speed; core/timestep.py check_fixed_dt), as in a preset."""
+    from .. import bench
+    from ..config import PresetError, overrides
+    from ..core import timestep
+    from ..core.params import Model
+    from ..scenes import hydrostatic_tank
+
+    if numerics.fixed_dt is None:
+        return
+    l0, kz = bench.DEFAULT_L0, bench.block_shape(n)[1]
+    # the physics depends on the depth only: a column a few particles wide builds at once
+    physics = hydrostatic_tank(dim=3, l0=l0, width=4 * l0, depth=kz * l0, re_ratio=2.1,
+                               numerics=numerics).physics
+    try:
+        timestep.check_fixed_dt(physics, numerics, Model.of(physics, numerics))
+    except ParameterError as e:
+        raise PresetError(overrides.SOURCE, "numerics.fixed_dt", e.value, "breaks a time-step "
+                          f"limit of the N = {n:,} block", e.allowed) from None
 
 
 def recorded_command(argv: Sequence[str], results) -> str:
@@ -133,10 +160,11 @@ def _bench_presets(args, argv: Sequence[str]) -> int:
     from .. import bench, config
 
     if args.n or args.compare:
-        raise ParameterError("--n/--compare", "given", "not with --preset (a preset sets its "
-                             "own particles and numerics; use --set)", "command line")
+        raise UsageError("--n and --compare apply to the tank block only, not with --preset "
+                         "(a preset sets its own particles and numerics; use --set) "
+                         "(see 'crowndemo bench --help')")
     if args.max_steps is not None and args.max_steps < 1:
-        raise ParameterError("max-steps", args.max_steps, "an integer >= 1", "command line")
+        raise ParameterError("max_steps", args.max_steps, "an integer >= 1", "command line")
     quality = args.quality or "booth"
     resolved = [config.load(spec, quality, args.sets) for spec in args.preset]
     start_backend(args)

@@ -189,9 +189,9 @@ def run_result(run: Dict, counts: Dict[str, int], setup_s: float) -> Dict:
 
 
 def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: float,
-                   setup_s: float, obs: Optional[Dict] = None) -> None:
+                  setup_s: float, obs: Optional[Dict] = None, dim: int = 3) -> None:
     """The summary of a run on stdout: particles, steps and dt with the limits that bound it,
-    health, an observable when there is one, wall time."""
+    health, an observable when there is one, wall time. In 2D energies are per unit depth."""
     stats, peak = run["stats"], run["peak"]
     h = stats.health
     e0, e1 = stats.energy_start, h.energy
@@ -209,7 +209,8 @@ def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: flo
     print(f"  health      max speed {h.max_speed:.4g} m/s (peak {peak['speed']:.4g}, "
           f"c = {sound_speed:.4g}); max density excess n/n0 - 1 = "
           f"{h.max_density_excess:.4g} (peak {peak['excess']:.4g})")
-    print(f"              energy {e0:.6g} J -> {e1:.6g} J{de}; left the domain: {left}")
+    unit = "J" if dim == 3 else "J/m"
+    print(f"              energy {e0:.6g} {unit} -> {e1:.6g} {unit}{de}; left the domain: {left}")
     if obs:
         print(f"  result      {obs['text']}")
     rate = stats.steps / stats.wall_seconds if stats.wall_seconds > 0 else math.nan

@@ -3,10 +3,14 @@ time-step limits of a lattice; pure host computation."""
 from __future__ import annotations
 
 import math
+import shlex
+import sys
 from typing import Dict
 
 from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
+from ..config.schema import LIQUID_KEYS, RUNG_KEYS, SCENE_KEYS, Field
+from ..core.params import ParameterError
 from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, load_preset)
 
 
@@ -22,7 +26,10 @@ examples:
 With PRESET: every resolved value and where it came from, n0, lambda0, C, the sound speed,
 each time-step limit and the one that binds, particles by kind, memory, steps to the end
 time, a rough run time, and what the scene leaves out. Without: the constants and limits of
-a lattice given by --dim and --l0 (and --speed, --rho, --nu, --sigma, ...).
+a lattice given by --dim and --l0 (and --speed, --rho, --nu, --sigma, ...), each within the
+range of the preset key it matches (l0 <= 0.01 m as quality.*.l0, speed <= 50 m/s as
+scene.speed, rho, nu and sigma as scene.liquid.*); a lattice whose time step would be below
+1e-08 s is refused, as a preset's run refuses it.
 Pure host computation: no Taichi kernel runs (the backend options are accepted and ignored).
 n0 and lambda0 come from a perfect lattice (S13), C from the cut-plane energy balance (S23).
 """
@@ -52,11 +59,97 @@ def _info(args) -> int:
     return _info_lattice(args)
 
 
+# the name a ParameterError gives each lattice option (cli/common.py OPTION_OF turns it into
+# the option) and the preset key whose range (config/schema.py) it shares
+LATTICE_RANGES = {"l0": ("l0", RUNG_KEYS["l0"]), "re_ratio": ("re_ratio", SCENE_KEYS["re_ratio"]),
+                  "rho": ("rho", LIQUID_KEYS["rho"]), "nu": ("nu", LIQUID_KEYS["nu"]),
+                  "sigma": ("sigma", LIQUID_KEYS["sigma"]),
+                  "speed": ("v_max", SCENE_KEYS["speed"]),
+                  "sound_speed": ("sound_speed", SCENE_KEYS["sound_speed"])}
+
+
+def in_range(field: Field, value) -> bool:
+    """Whether ``value`` is a finite number inside a schema Field's range."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not math.isfinite(value):
+        return False
+    lo, hi = field.lo, field.hi
+    low = lo is not None and (value < lo or (value == lo and not field.lo_incl))
+    high = hi is not None and (value > hi or (value == hi and not field.hi_incl))
+    return not (low or high)
+
+
+def check_range(key: str, value, field: Field, source: str = "command line") -> None:
+    """ParameterError naming ``key`` when ``value`` is outside the schema Field's range."""
+    if not in_range(field, value):
+        raise ParameterError(key, value, field.allowed(), source)
+
+
+def _check_lattice_ranges(args) -> None:
+    """The lattice options within the ranges of a preset's keys: l0 as quality.*.l0, the
+    liquid as scene.liquid.*, the speeds and re_ratio as scene.*."""
+    for opt, (key, field) in LATTICE_RANGES.items():
+        value = getattr(args, opt)
+        if value is not None:
+            check_range(key, value, field, "info")
+
+
+def ceil3(x: float) -> float:
+    """``x`` rounded up to 3 significant digits: a ">=" bound that, printed, still passes."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.ceil(x / step * (1 - 1e-12)) * step
+
+
+def floor3(x: float) -> float:
+    """``x`` rounded down to 3 significant digits: a "<=" bound that, printed, still passes."""
+    step = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.floor(x / step * (1 + 1e-12)) * step
+
+
+def _l0_for_dt(name: str, physics, numerics, dt: float) -> float:
+    """The l0 at which the ``name`` limit (core/timestep.py) equals ``dt``."""
+    if name == "courant":
+        return dt * physics.v_max / numerics.courant
+    if name == "acoustic":
+        return dt * physics.c / numerics.acoustic
+    if name == "viscous":
+        return math.sqrt(dt * physics.nu / numerics.viscous)
+    assert name == "capillary", name
+    return ((dt / numerics.capillary) ** 2 * 2.0 * math.pi * physics.sigma / physics.rho) ** (1 / 3)
+
+
+def _check_dt_floor(physics, numerics, lim: Dict[str, float]) -> None:
+    """Refuse a lattice whose time step a preset's run would refuse (below DT_FLOOR,
+    config/resolve.py): name l0 and the finest spacing that passes or, where no l0 in its
+    range does (a liquid far too light for its surface tension), rho."""
+    from ..config.resolve import DT_FLOOR
+
+    name = min(lim, key=lim.get)
+    if not math.isfinite(lim[name]):        # no nu, no sigma, and l0 / v overflows
+        slowest = numerics.courant * physics.l0 / sys.float_info.max
+        raise ParameterError("v_max", physics.v_max, f"> {slowest * 1.01:.3g} m/s (slower, "
+                             "the Courant limit l0 / v overflows: dt would be infinite)", "info")
+    if lim[name] >= DT_FLOOR:
+        return
+    why = (f"below, dt = {lim[name]:.3g} s (the {name} limit) is under the {DT_FLOOR:g} s "
+           "that a run accepts")
+    need = max(_l0_for_dt(k, physics, numerics, DT_FLOOR) for k in lim)
+    l0_max = RUNG_KEYS["l0"].hi
+    if need <= l0_max:
+        raise ParameterError("l0", physics.l0, f">= {ceil3(need):.3g} m and <= {l0_max:g} m "
+                             f"here: {why}", "info")
+    rho = (DT_FLOOR / numerics.capillary) ** 2 * 2.0 * math.pi * physics.sigma / l0_max ** 3
+    raise ParameterError("rho", physics.rho, f">= {ceil3(rho):.3g} kg/m^3 at sigma = "
+                         f"{physics.sigma:g} N/m: lighter, the capillary limit leaves dt under "
+                         f"{DT_FLOOR:g} s at every l0 <= {l0_max:g} m", "info")
+
+
 def _info_lattice(args) -> int:
     from ..core import timestep
     from ..core.lattice import LatticeConstants
-    from ..core.params import Model, Numerics, ParameterError, Physics
+    from ..core.params import Model, Numerics, Physics
 
+    _check_lattice_ranges(args)
     physics = Physics(dim=args.dim, l0=args.l0, v_max=args.speed, re_ratio=args.re_ratio,
                       rho=args.rho, nu=args.nu, sigma=args.sigma,
                       sound_speed=args.sound_speed).validate("info")
@@ -68,9 +161,10 @@ def _info_lattice(args) -> int:
                              f"(a run stops when a particle is faster than max_mach * c, "
                              f"max_mach = {numerics.max_mach:g})", "info")
     model = Model.of(physics, numerics)
+    lim = timestep.limits(physics, numerics, model, physics.v_max)
+    _check_dt_floor(physics, numerics, lim)
     lat = LatticeConstants.compute(physics.dim, physics.l0, physics.re_ratio, physics.rho,
                                    physics.sigma)
-    lim = timestep.limits(physics, numerics, model, physics.v_max)
     dt, binding = timestep.choose(physics, numerics, model, physics.v_max)
     ties = [k for k, v in lim.items() if v <= dt * (1 + 1e-9)]
     all_limits = {k: lim.get(k) for k in ("courant", "acoustic", "viscous", "capillary")}
@@ -124,6 +218,7 @@ def _preset_facts(r, tp) -> Dict:
     from ..core.lattice import LatticeConstants
     from ..core.params import Model
     from ..core.step import max_particles
+    from ..record.recorder import frame_times
     from ..scenes.crown import crown_base_radius
 
     ph, s, liq = r.physics, r.scene, r.liquid
@@ -142,12 +237,13 @@ def _preset_facts(r, tp) -> Dict:
     numerics = {key: (None if isinstance(v, float) and math.isinf(v) else v)
                 for key, v in asdict(r.numerics).items() if key != "allow_unsafe_dt"}
     return {
-        "preset": r.name, "file": r.label, "extends_chain": r.doc.chain, "quality": r.quality,
+        "preset": r.name, "file": r.label, "extends_chain": _files(r.doc.chain),
+        "quality": r.quality,
         "title": r.title, "description": r.description, "dim": r.dim,
         "scene": {"floor_m": s["floor"], "film_m": h, "drop_m": D, "speed_m_s": U,
                   "height_m": s.get("height"), "gap_m": s["gap"],
                   "gravity_m_s2": s["gravity"], "t_end_s": s["t_end"],
-                  "frame_interval_s": s.get("frame_interval"), "frames": len(r.frame_times()),
+                  "frame_interval_s": s.get("frame_interval"), "frames": len(frame_times(r)),
                   "trim": s["trim"], "impact_at_s": impact},
         "sources": {k: {"key": key, "file": src} for k, (key, src) in sorted(r.where.items())},
         "liquid": {"name": liq["name"], "rho_kg_m3": liq["rho"], "nu_m2_s": liq["nu"],
@@ -185,6 +281,12 @@ def _preset_facts(r, tp) -> Dict:
     }
 
 
+def _files(chain) -> list:
+    """A Document's chain of preset files, base first, without the ``--set`` layer."""
+    from ..config.overrides import SOURCE
+    return [label for label in chain if label != SOURCE]
+
+
 def _speed_in_c(v: float, c: float) -> str:
     """'8 m/s = 0.2 c': a speed and its ratio to the sound speed c."""
     return f"{v:.3g} m/s = {v / c:.2g} c"
@@ -202,6 +304,7 @@ def _info_preset(args) -> int:
     r = load_preset(args.preset, args)
     tp = estimate.throughput()
     f = _preset_facts(r, tp)
+    f["overrides"] = list(args.sets)
     if args.json:
         print(strictjson.dumps(f))
         return 0
@@ -209,8 +312,10 @@ def _info_preset(args) -> int:
     src = {k: v["key"] for k, v in f["sources"].items()}
     lang = "en"
     print(f"preset {r.name}, quality {r.quality} ({r.label}): {r.dim}D")
-    if len(r.doc.chain) > 1:
-        print(f"  extends     {' <- '.join(reversed(r.doc.chain))}")
+    if len(f["extends_chain"]) > 1:
+        print(f"  extends     {' <- '.join(reversed(f['extends_chain']))}")
+    if f["overrides"]:
+        print("  overrides   " + " ".join("--set " + shlex.quote(o) for o in f["overrides"]))
     print(f"  title       {f['title'].get(lang, '')}")
     if f["description"].get(lang):
         for i, line in enumerate(textwrap.wrap(f["description"][lang], 82)):
@@ -221,8 +326,9 @@ def _info_preset(args) -> int:
     print(f"  scene       {_mm(s['floor_m'])} {floor}, film h = {_mm(s['film_m'])}, drop D = "
           f"{_mm(s['drop_m'])}, gap {_mm(s['gap_m'])}")
     print(f"              {speed} ({src['speed']}); contact at t = {s['impact_at_s'] * 1e3:.4g} ms")
-    frames = (f"; frames every {s['frame_interval_s'] * 1e3:g} ms ({s['frames']})"
-              if s["frame_interval_s"] else "; no frames")
+    # as `record` writes them: t = 0 and every frame interval to t_end (record/recorder.py)
+    frames = (f"; {s['frames']} frames, every {s['frame_interval_s'] * 1e3:g} ms from t = 0"
+              if s["frame_interval_s"] else "; 1 frame (t = 0; no frame_interval)")
     print(f"              t_end = {s['t_end_s'] * 1e3:g} ms ({src['t_end']}){frames}")
     print(f"  liquid      {liq['name']}: rho {liq['rho_kg_m3']:g} kg/m^3, nu {liq['nu_m2_s']:g} "
           f"m^2/s, sigma {liq['sigma_N_m']:g} N/m; gravity {s['gravity_m_s2']:g} m/s^2")
@@ -309,7 +415,7 @@ def register(sub, common) -> None:
                    help=SET_HELP)
     p.add_argument("--dim", type=int, metavar="D", help="without PRESET: dimension, 2 or 3")
     p.add_argument("--l0", type=float, metavar="M",
-                   help="without PRESET: particle spacing [m]")
+                   help="without PRESET: particle spacing [m], > 0 and <= 0.01")
     p.add_argument("--re-ratio", type=float, help="re / l0 (default: 2.1)")
     p.add_argument("--sigma", type=float,
                    help="surface tension [N/m] (default: 0.0728, water; 0 turns it off)")

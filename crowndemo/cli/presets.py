@@ -24,10 +24,16 @@ counts marked ~ are scaled from a build at a coarser spacing. The run time is ro
 run's compile (5 s in 2D, 50 s in 3D, measured; a run whose kernels are in Taichi's cache
 starts in 3-9 s) + (every particle) x steps x 0.8 (a crown step's cost per particle against
 the bench's, measured) / the rate of the newest CPU section of BENCHMARKS.md (--rate: another
-machine's). Steps: dt at the drop's speed until it touches the film, then at the splash's
-speed, 0.5 c (with the Courant limit on relative speeds, 0.3 c relative), as measured on crown
-runs. The table's footer names the figures used; `crowndemo info PRESET` shows the steps.
+machine's, 1e3 to 1e12 fluid particle-steps/s). Steps: dt at the drop's speed until it
+touches the film, then at the splash's speed, 0.5 c (with the Courant limit on relative
+speeds, 0.3 c relative), as measured on crown runs. The table's footer names the figures
+used; `crowndemo info PRESET` shows the steps.
 """
+
+
+# --rate: from a slow single core to far beyond any machine of today (BENCHMARKS.md: about
+# 2e6 on 2 CPU cores); outside, the run times printed would mean nothing
+RATE_RANGE = (1.0e3, 1.0e12)
 
 
 def _display_width(text: str) -> int:
@@ -45,9 +51,10 @@ def _presets(args) -> int:
     from .. import config
     from ..config import estimate, schema
 
-    if args.rate is not None and not (math.isfinite(args.rate) and args.rate > 0):
-        raise ParameterError("rate", args.rate, "> 0 fluid particle-steps per second",
-                             "command line")
+    lo, hi = RATE_RANGE
+    if args.rate is not None and not (math.isfinite(args.rate) and lo <= args.rate <= hi):
+        raise ParameterError("rate", args.rate, f">= {lo:g} and <= {hi:g} fluid particle-steps "
+                             "per second", "command line")
     tp = estimate.throughput(rate=args.rate)
     folder = config.presets_dir()
     rows, errors = [], []
@@ -125,7 +132,7 @@ def register(sub, common) -> None:
     p.add_argument("--lang", choices=("en", "ja"), default="en",
                    help="language of the titles (default: en)")
     p.add_argument("--rate", type=float, metavar="R",
-                   help="fluid particle-steps per second to estimate with (default: the "
-                        "newest CPU figure in BENCHMARKS.md)")
+                   help="fluid particle-steps per second to estimate with, 1e3 to 1e12 "
+                        "(default: the newest CPU figure in BENCHMARKS.md)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=lambda a, argv: _presets(a))

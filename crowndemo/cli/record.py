@@ -32,8 +32,8 @@ snapshots/frame_NNNNN.npz (particles at t = 0 and every frame interval;
 fluid only unless --all-particles), checkpoint.npz (the full state, for --resume) and
 metadata.json (parameters, particle counts, dt, health, wall time, versions, frames, and
 status: running, complete, interrupted or unstable). Recording a preset afresh replaces
-its earlier recording, frames and videos included (said on stderr). Files are written under a temporary name and
-renamed, so a file that exists is whole.
+its earlier recording, frames and videos included (said on stderr). Files are written
+under a temporary name and renamed, so a file that exists is whole.
 
 Ctrl-C stops after the current step: the frames so far are kept, a checkpoint is saved,
 metadata.json says "interrupted", and the command prints how to resume (exit 130). A
@@ -260,7 +260,7 @@ def _record(args) -> int:
                 head = (f"preset {r.name} ({r.quality}): {r.dim}D, l0 = {r.l0:g} m, U = "
                         f"{r.speed:.4g} m/s; arch {be.resolved}, {be.precision}")
                 print_summary(head, run, res.sim.counts(), res.scene.physics.c,
-                              res.log.setup_seconds)
+                              res.log.setup_seconds, dim=r.dim)
                 print(f"  recording   {folder}: {len(res.log.frames)} of "
                       f"{len(res.frame_times)} frames; status {res.status.split(':')[0]}")
             if render and not args.json:

@@ -85,7 +85,7 @@ def _run(args) -> int:
                         f"{r.speed:.4g} m/s, film {s['film']:g} m, drop {s['drop']:g} m; "
                         f"gradient {r.numerics.pressure_gradient}; arch {be.resolved}, "
                         f"{be.precision}")
-                print_summary(head, run, counts, scene.physics.c, setup_s)
+                print_summary(head, run, counts, scene.physics.c, setup_s, dim=r.dim)
                 st = results[-1]["startup"]
                 print(f"  start-up    {st['seconds']:.2f} s (set-up {setup_s:.2f} s + first step "
                       f"{first:.2f} s); {st['session']}; {st['kernels_compiled']} kernels "

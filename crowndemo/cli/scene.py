@@ -5,11 +5,13 @@ from __future__ import annotations
 import math
 import sys
 import time
-from typing import Dict
+from typing import Callable, Dict
 
 from .. import strictjson
 from ..core.params import GRADIENT_FORMS, Numerics, ParameterError
+from ..config.schema import LIQUID_KEYS, SCENE_KEYS
 from .common import (NUMERICS, PROG, Fmt, print_summary, run_result, simulate, start_backend)
+from .info import ceil3, check_range, floor3
 
 
 # per scene, by dimension: the defaults of its options (keys are the builders' keywords)
@@ -54,7 +56,7 @@ def _positive(key: str, value: float, unit: str) -> None:
         raise ParameterError(key, value, f"> 0 {unit}".rstrip(), "command line")
 
 
-def _particles(name: str, dim: int, val: Dict) -> int:
+def _particles(name: str, dim: int, val: Dict) -> float:
     """The scene's particles, counted before numpy builds it: the fluid block and the shell of
     wall and dummy layers around the container (hydrostatic_tank, dam_break and square_patch
     in scenes/reference.py; within a few per cent)."""
@@ -62,7 +64,11 @@ def _particles(name: str, dim: int, val: Dict) -> int:
 
     l0 = val["l0"]
     layers = wall_layers(2.1)                  # the builders' default re = 2.1 l0
-    points = lambda extents: math.prod(int(e / l0 + 1e-9) for e in extents)
+
+    def points(extents) -> float:            # inf for absurd sizes: 1e100 l0 or more
+        ks = [e / l0 + 1e-9 for e in extents]
+        return math.prod(int(k) for k in ks) if all(k < 1e100 for k in ks) else math.inf
+
     if name == "patch":
         return points([val["side"]] * dim)
     if name == "tank":
@@ -73,22 +79,30 @@ def _particles(name: str, dim: int, val: Dict) -> int:
         inner, fluid = [4.0 * a] + [a] * (dim - 2) + [2.5 * a], [a] * (dim - 1) + [2.0 * a]
     # walls on every side face and the floor: layers more points each way, one way up
     outer = [e + 2 * layers * l0 for e in inner[:-1]] + [inner[-1] + layers * l0]
+    if points(outer) == math.inf:
+        return math.inf
     return points(fluid) + points(outer) - points(inner)
+
+
+SIZES = ("width", "depth", "a", "side")
+# the options that share a preset key's range (config/schema.py)
+SCHEMA_RANGES = {"t_end": SCENE_KEYS["t_end"], "nu": LIQUID_KEYS["nu"],
+                 "sigma": LIQUID_KEYS["sigma"]}
 
 
 def _values(name: str, args, numerics: Numerics) -> Dict:
     """The scene's options with their defaults, checked (a ParameterError names the option)
-    before Taichi starts or numpy allocates: positive sizes, sizes of at least l0, and at
-    most the particles one simulator holds (core/step.py, max_particles)."""
-    from ..core.params import Model
-    from ..core.step import max_particles
-
+    before Taichi starts or numpy allocates: positive sizes, sizes of at least l0, t_end, nu
+    and sigma in a preset's ranges, and at most the particles one simulator holds
+    (core/step.py, max_particles)."""
     d = SCENES[name]["defaults"][args.dim]
     val = {k: (getattr(args, k) if getattr(args, k, None) is not None else v)
            for k, v in d.items()}
     _positive("l0", val["l0"], "m")
-    _positive("t_end", val["t_end"], "s")
-    for k in ("width", "depth", "a", "side"):
+    for k, field in SCHEMA_RANGES.items():
+        if k in val:
+            check_range(k, val[k], field)
+    for k in SIZES:
         if k in val:
             _positive(k, val[k], "m")
             # the reference figure needs a body, not a handful of particles
@@ -96,17 +110,54 @@ def _values(name: str, args, numerics: Numerics) -> Dict:
                 raise ParameterError(k, val[k], f">= {ACROSS_MIN} l0 = "
                                      f"{ACROSS_MIN * val['l0']:g} m ({ACROSS_MIN} particles "
                                      "across at least)", "command line")
+    _check_size(name, args, val, numerics)
+    return val
+
+
+def _edge(ok: Callable[[float], bool], good: float, bad: float) -> float:
+    """The value nearest ``bad`` where ``ok`` (true at ``good``, false at ``bad``) still
+    holds: bisection on a log scale, as sizes may span hundreds of decades."""
+    while abs(math.log(bad) - math.log(good)) > 1e-4:
+        mid = math.sqrt(good) * math.sqrt(bad)
+        good, bad = (mid, bad) if ok(mid) else (good, mid)
+    return good
+
+
+def _check_size(name: str, args, val: Dict, numerics: Numerics) -> None:
+    """Refuse a scene that one simulator cannot hold (core/step.py, max_particles). The
+    message names a size given on the command line, with the largest that fits at this l0,
+    unless l0 was given too and a coarser one fits; else l0, with the finest that fits."""
+    from ..core.params import Model
+    from ..core.step import max_particles
+
     model = Model(args.dim, False, False, False, numerics.pressure_gradient,
                   numerics.collision > 0, numerics.neighbour_list)
     limit = max_particles(model)
+    fits = lambda **change: _particles(name, args.dim, {**val, **change}) <= limit
     n = _particles(name, args.dim, val)
-    if n > limit:
-        coarsest = val["l0"] * (n / limit) ** (1.0 / args.dim)
-        raise ParameterError("l0", val["l0"],
-                             f">= {coarsest:.3g} m for this scene's sizes: at l0 = "
-                             f"{val['l0']:g} m it has ~{n:,} particles, one simulator holds "
-                             f"at most {limit:,}", "command line")
-    return val
+    if n <= limit:
+        return
+    l0 = val["l0"]
+    count = f"{n:,}" if n < 1e15 else f"{n:.3g}" if math.isfinite(n) else "over 1e100"
+    where = (f"at l0 = {l0:g} m the scene has ~{count} particles, one simulator holds at "
+             f"most {limit:,}")
+    sizes = [k for k in SIZES if k in val]
+    smallest = ACROSS_MIN * l0           # a size below holds too few particles across
+    largest = {k: _edge(lambda v, k=k: fits(**{k: v}), smallest, val[k])
+               for k in sizes if getattr(args, k, None) is not None and fits(**{k: smallest})}
+    coarsest = min(val[k] for k in sizes) / ACROSS_MIN     # l0 beyond: too few across
+    l0_helps = fits(l0=coarsest)
+    if largest and (args.l0 is None or not l0_helps):
+        k = min(largest, key=lambda k: largest[k] / val[k])
+        raise ParameterError(k, val[k], f">= {smallest:g} m and <= {floor3(largest[k]):.3g} m "
+                             f"here: {where}", "command line")
+    if not l0_helps:                     # neither a coarser l0 nor one smaller size alone
+        given = [f"--{k}" for k in sizes if getattr(args, k, None) is not None]
+        raise ParameterError("l0", l0, f"a coarser l0 together with a smaller "
+                             f"{' or '.join(given) or 'scene'}: {where}", "command line")
+    need = ceil3(_edge(lambda v: fits(l0=v), coarsest, l0))
+    raise ParameterError("l0", l0, f">= {need:.3g} m for this scene's sizes: {where}",
+                         "command line")
 
 
 def _numerics(args) -> Numerics:
@@ -199,14 +250,16 @@ def _scene(args) -> int:
     result = {"scene": name, "dim": args.dim, "parameters": val, "gradient": args.gradient,
               "sound_speed_m_s": scene.physics.c, "arch": be.arch,
               "resolved_arch": be.resolved, "precision": be.precision,
-              **run_result(run, counts, setup_s), "observables": obs}
+              **run_result(run, counts, setup_s), "observables": obs,
+              # health.energy_J and energy_start_J: per unit depth in 2D, as info's masses
+              "energy_unit": "J" if args.dim == 3 else "J/m (per unit depth)"}
     if args.json:
         print(strictjson.dumps(result))
         return 0
     size = ", ".join(f"{k} {v:g}" for k, v in val.items() if k not in ("l0", "t_end"))
     head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {size}; gradient "
             f"{args.gradient}; arch {be.resolved}, {be.precision}")
-    print_summary(head, run, counts, scene.physics.c, setup_s, obs)
+    print_summary(head, run, counts, scene.physics.c, setup_s, obs, dim=args.dim)
     return 0
 
 

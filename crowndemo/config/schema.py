@@ -248,6 +248,11 @@ def _range(f: Field, v, path, doc: Document) -> None:
         _fail(doc, path, v, "out of range", f.allowed())
 
 
+def check_numerics(values: dict, doc: Document) -> dict:
+    """A ``numerics`` mapping checked as a preset's is (unknown keys, types, ranges)."""
+    return _check_map(NUMERICS_KEYS, values, ("numerics",), doc)
+
+
 def _check_map(keys: Dict[str, Field], v: dict, path, doc: Document) -> dict:
     for k, item in v.items():
         if k not in keys:
@@ -267,4 +272,4 @@ def _check_map(keys: Dict[str, Field], v: dict, path, doc: Document) -> dict:
 
 
 __all__ = ["validate", "Field", "QUALITIES", "LIQUIDS", "TOP_KEYS", "SCENE_KEYS",
-           "NUMERICS_KEYS", "RUNG_KEYS", "LIQUID_KEYS", "dotted"]
+           "NUMERICS_KEYS", "RUNG_KEYS", "LIQUID_KEYS", "check_numerics", "dotted"]

@@ -11,6 +11,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .params import ParameterError
+
+# l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
+# user's spacing is checked against its command's own, narrower range first (cli/info.py)
+L0_FLOAT_RANGE = (1.0e-100, 1.0e100)
+
 
 def weight(r: np.ndarray, re: float) -> np.ndarray:
     """w(r) = re/r - 1 for 0 < r < re, else 0 (S10)."""
@@ -84,6 +90,10 @@ class LatticeConstants:
     @classmethod
     def compute(cls, dim: int, l0: float, re_ratio: float, rho: float, sigma: float
                 ) -> "LatticeConstants":
+        lo, hi = L0_FLOAT_RANGE
+        if not lo <= l0 <= hi:      # beyond, l0 ** 3 overflows or the cut sum is 0 (S23)
+            raise ParameterError("l0", l0, f"{lo:g} .. {hi:g} m (the lattice sums stay finite "
+                                 "floats)", "lattice")
         re = re_ratio * l0
         n0, lam = n0_lambda0(dim, l0, re)
         return cls(dim, l0, re, n0, lam, surface_tension_coefficient(dim, l0, re, sigma),
