@@ -71,6 +71,7 @@ def test_a_slow_drop_takes_its_sound_speed_from_the_capillary_speed():
     sigma, rho = r.liquid["sigma"], r.liquid["rho"]
     assert r.physics.c == pytest.approx(5.0 * math.sqrt(2.25 * sigma / (rho * r.l0)), rel=0.01)
     assert r.physics.c > 2.5 * 5.0 * r.speed
+    assert r.scene["sound_speed_source"].startswith("5 x the capillary speed")
     scene = r.build_scene()
     assert scene.physics.c == r.physics.c
     sim = simulator_for(scene)
@@ -317,6 +318,7 @@ BAD_SETS = [
     ("=3", ["(empty key) = '3': not a dotted key path"]),
     ("scene.speed=[1,", ["not valid YAML"]),
     ("extends=3m-drop", ["extends = '3m-drop': extends cannot be changed with --set"]),
+    ("scene.liquid.rho=1", ["scene.liquid.rho = 1.0: out of range", ">= 100 and <= 25000"]),
 ]
 
 
@@ -328,6 +330,17 @@ def test_bad_set_gives_one_clear_error(capsys, item, fragments):
     assert err.count("\n") == 1 and "Traceback" not in err
     for fragment in fragments:
         assert fragment in err, (fragment, err)
+
+
+def test_a_slow_drop_too_fine_for_its_sound_speed_names_l0(capsys):
+    """c from the capillary speed, which grows as 1/sqrt(l0): the acoustic dt l0/c falls as
+    l0^1.5, and the finest l0 named gives dt = 1e-8 s: at 3e-7 m dt = 2.56e-9 s, so l0 >=
+    3e-7 (1e-8 / 2.56e-9)^(2/3) = 7.44e-7 m."""
+    argv = ["info", "quick-2d", "--set", "quality.draft.l0=3e-7", "--set", "scene.speed=0.01"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "quality.draft.l0 = 3e-07" in err and "c = 5 x the capillary speed" in err
+    assert "allowed: >= 7.44e-07 m" in err and err.count("\n") == 1
 
 
 def test_unknown_preset_name_suggests_one(capsys):

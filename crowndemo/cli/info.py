@@ -253,7 +253,8 @@ def _preset_facts(r, tp) -> Dict:
         "lambda0_over_l0_sq": lat.lambda0 / lat.l0 ** 2, "C": lat.C, "mass": lat.mass,
         "mass_unit": "kg" if ph.dim == 3 else "kg/m (per unit depth)",
         "sound_speed_m_s": ph.c,
-        "sound_speed_source": "given" if s.get("sound_speed") is not None else "5 x speed",
+        "sound_speed_source": s.get("sound_speed_source") or (
+            "given" if s.get("sound_speed") is not None else "5 x speed"),
         "numerics": numerics, "model": Model.describe(r.model),
         "limits_s": {key: lim.get(key) for key in ("courant", "approach", "acoustic",
                                                     "viscous", "capillary", "dt_max")

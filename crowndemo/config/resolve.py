@@ -209,9 +209,11 @@ def resolve(doc: Document, quality: str) -> Resolved:
 
     # the sound speed: c = 5 v_max (S8), v_max the scene's largest speed scale
     if scene.get("sound_speed") is None:
-        floor = slow_speed_floor(dim, l0, scene, liquid)
+        floor, which = slow_speed_floor(dim, l0, scene, liquid)
         if floor > scene["speed"]:
             scene["sound_speed"] = SOUND_SPEED_FACTOR * floor
+            scene["sound_speed_source"] = (f"5 x the {which} speed {floor:.3g} m/s, above "
+                                           f"U = {scene['speed']:.3g} m/s")
             where["sound_speed"] = where["speed"]
 
     # the core's own checks (the schema's ranges make these pass; kept as a safety net)
@@ -244,6 +246,13 @@ def resolve(doc: Document, quality: str) -> Resolved:
         if dt_name == "courant":
             fail("speed", scene.get("height", scene["speed"]), why,
                  f"U <= {numerics.courant * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
+        elif dt_name == "acoustic" and "sound_speed_source" in scene:
+            # c from the slow drop's floor: the capillary speed falls as 1/sqrt(l0)
+            c = scene["sound_speed"]
+            need = (DT_FLOOR * c / numerics.acoustic if which == "fall" else
+                    (DT_FLOOR * c * math.sqrt(l0) / numerics.acoustic) ** (2.0 / 3.0))
+            fail("l0", l0, f"{why}; c = {scene['sound_speed_source']}",
+                 f">= {need * 1.001:.3g} m")
         elif dt_name == "acoustic" and scene.get("sound_speed") is not None:
             fail("sound_speed", scene["sound_speed"], why,
                  f"<= {numerics.acoustic * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
@@ -271,7 +280,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
 SOUND_SPEED_FACTOR = 5.0     # c = 5 v_max (method.md S8): (v/c)^2 = 4 % compression
 
 
-def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> float:
+def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> Tuple[float, str]:
     """The speeds a drop on a film reaches whatever its impact speed U (m/s), which c = 5 U
     would not cover when U is small: the fall, sqrt(2 g (gap + D)) (a drop let go at the
     gap, its top falling a diameter more as it lands), and the capillary speed
@@ -279,7 +288,7 @@ def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> float:
     (2.25 sigma/l0 in 2D at re = 2.1 l0) the equation of state must balance inside the
     liquid. With c = 5 U alone a 0.5 m/s drop at l0 = 0.1 mm (c = 2.5 m/s) was compressed
     26 % by that stress and went unstable at its 6th step. No shipped preset reaches this
-    floor (tests/test_presets.py), so their c stays 5 U."""
+    floor (tests/test_presets.py), so their c stays 5 U. Returns the larger and its name."""
     from ..core.lattice import LatticeConstants
     from ..validate.observables import lattice_cohesion_pressure
     fall = math.sqrt(2.0 * scene["gravity"] * (scene["gap"] + scene["drop"]))
@@ -289,7 +298,7 @@ def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> float:
                                        liquid["sigma"])
         cohesion = -lattice_cohesion_pressure(dim, l0, lat.re, lat.C)
         capillary = math.sqrt(max(cohesion, 0.0) / liquid["rho"])
-    return max(fall, capillary)
+    return max((fall, "fall"), (capillary, "capillary"))
 
 
 def _speed_source(doc: Document) -> str:

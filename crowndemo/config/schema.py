@@ -89,7 +89,9 @@ TEXT = Field("text", "a text in English (en) and Japanese (ja)")
 LIQUID_KEYS = {
     "name": Field("choice", "a named liquid whose values the other keys override",
                   choices=tuple(LIQUIDS), default="water"),
-    "rho": number("density", "kg/m^3", 0, 25000),
+    # liquids (about 700-13,600 kg/m^3); a far lighter one makes the capillary speed, and so
+    # the sound speed and time step of a slow drop (config/resolve.py), meaningless
+    "rho": number("density", "kg/m^3", 100, 25000, lo_incl=True),
     "nu": number("kinematic viscosity (0: no viscosity term)", "m^2/s", 0, 0.1, lo_incl=True),
     "sigma": number("surface tension (0: no surface-tension term)", "N/m", 0, 1, lo_incl=True),
 }
