@@ -241,6 +241,28 @@ def test_counts_of_an_earlier_build_do_not_linger(sims, dim):
         check_against_brute_force(sim, walker, as_loaded(sim), kind)
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_coincident_and_non_finite_particles(sims, dim):
+    """A particle exactly on another is not its neighbour (w and 1/r^2 would be infinite),
+    and a non-finite position (a run blowing up, reported by the health check after the
+    step) neither widens the grid to garbage nor is anyone's neighbour."""
+    pos = np.zeros((5, dim))
+    pos[2, 0] = 0.5 * RE            # a, b coincident at 0; c near both; d far; e at inf
+    pos[3, 0] = 20.0 * RE
+    kind = np.full(5, FLUID, dtype=np.int32)
+    sim, walker = load(sims, dim, BIG[dim], pos, kind)
+    p = sim.state.pos.to_numpy()
+    p[4] = np.inf
+    sim.state.pos.from_numpy(p)
+    sim.grid.build(RE)
+    assert np.isfinite(sim.grid.side[None]) and sim.grid.side[None] == pytest.approx(
+        RE / sim.grid.reach, rel=1e-6)
+    assert 0 < sim.grid.num_cells[None] <= sim.grid.max_cells
+    count, nbr = walker.pairs(RE)
+    found = [sorted(nbr[k, :count[k]].tolist()) for k in range(4)]
+    assert found == [[2], [2], [0, 1], []]
+
+
 def test_single_and_empty_live_sets(sims):
     """One live particle has no neighbours; all parked: nothing is walked."""
     pos = np.array([[0.0, 0.0], [0.5 * RE, 0.0], [3.0, 3.0]])

@@ -25,6 +25,9 @@ from .state import GONE, ParticleState
 warnings.filterwarnings("ignore", message="You are unrolling more than", category=SyntaxWarning)
 
 
+FAR = 1.0e30       # |coordinate| beyond this (inf, NaN fails the test too) is not a bound
+
+
 def row_reach(off, k: int) -> int:
     """How far along axis 0 the walk's row at cell offset ``off`` (axes 1..d-1) reaches, in
     cells of side h = re/k: the largest |o_0| such that the cell at (o_0, off) can hold a point
@@ -114,7 +117,9 @@ class CellGrid:
             lo = ti.Vector([3.0e38] * d)
             hi = ti.Vector([-3.0e38] * d)
             for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
-                if kind[i] != GONE:
+                # a non-finite position (a run blowing up, which the health check after the
+                # step reports) must not make the cell side and dimensions garbage
+                if kind[i] != GONE and (ti.abs(pos[i]) < FAR).all():
                     lo = ti.min(lo, pos[i])
                     hi = ti.max(hi, pos[i])
             self.block_lo[b] = lo
@@ -226,7 +231,7 @@ class CellGrid:
 
     @ti.func
     def for_each_neighbour(self, i, xi, re2, task: ti.template(), acc: ti.template()):
-        """Call ``task(i, j, rij, r2, acc)`` for every live j != i with r2 = |rij|^2 < re2,
+        """Call ``task(i, j, rij, r2, acc)`` for every live j with 0 < r2 = |rij|^2 < re2,
         rij = x_j - x_i, at the positions of the last ``build``; re2 at most the square of the
         ``min_side`` it was given (the stencil of the module docstring holds up to that)."""
         self._walk(i, xi, re2, task, acc, False)
@@ -288,7 +293,7 @@ class CellGrid:
         for s in range(begin, end):
             rij = self.sorted_pos[s] - xi
             r2 = rij.dot(rij)
-            if r2 < re2:
-                j = self.order[s]
-                if j != i:
-                    task(i, j, rij, r2, acc)
+            # 0 < r2: i itself, and a particle exactly on it (w = inf, 1/r^2; the collision
+            # model keeps pairs apart), are not neighbours
+            if r2 < re2 and r2 > 0.0:
+                task(i, self.order[s], rij, r2, acc)

@@ -82,8 +82,10 @@ class PlaneFloor:
     @ti.func
     def at(self, s):
         """(n_floor, g_floor, v_floor) at height s, linear between samples; zero past the top."""
-        x = (ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None]
-        row = ti.min(ti.cast(ti.floor(x), ti.i32), SAMPLES - 1)
+        # clamped before the cast: a height far up (or inf, NaN) would cast to INT_MIN
+        x = ti.min((ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None],
+                   float(SAMPLES - 1))
+        row = ti.max(ti.min(ti.cast(ti.floor(x), ti.i32), SAMPLES - 1), 0)
         frac = ti.min(x - row, 1.0)
         upper = ti.min(row + 1, SAMPLES - 1)      # the last sample is zero: zero past it
         return (1.0 - frac) * self.table[row] + frac * self.table[upper]
