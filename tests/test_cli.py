@@ -147,6 +147,22 @@ def test_bench_preset_unstable_reports_the_finished_ones(tmp_path, capsys):
     assert "unstable at step 1" in err and "Traceback" not in err
 
 
+def test_run_chain_unstable_reports_the_finished_ones(tmp_path, capsys):
+    """A later preset of a chain going unstable: the finished runs are still reported (with
+    --json, a list ending in the unstable one's step and cause), the error names the preset,
+    and the presets after it are named as not run; exit 3."""
+    bad = tmp_path / "unstable.yaml"           # max_mach * c just above U: the first step
+    bad.write_text("extends: quick-2d\nnumerics: {max_mach: 0.2000001}\n")
+    assert main(["run", "quick-2d", "--then", str(bad), "quick-2d", "--max-steps", "2",
+                 "--json", "--quiet"]) == 3
+    out, err = capsys.readouterr()
+    first, broken = json.loads(out)
+    assert first["preset"] == "quick-2d" and first["steps"] == 2
+    assert broken["preset"] == "unstable" and broken["unstable"]["step"] == 1
+    assert "max_mach" in broken["unstable"]["what"]
+    assert "crowndemo: unstable: unstable at step 1" in err and "not run: quick-2d" in err
+
+
 def test_scene_dam_break_2d(capsys):
     assert main(["scene", "dam-break", "--dim", "2", "--t-end", "0.005"]) == 0
     out = capsys.readouterr().out

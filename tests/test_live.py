@@ -31,7 +31,8 @@ def test_sliders_map_to_preset_values(controller):
     assert r.scene["film"] == pytest.approx(8e-4)
     assert r.scene["drop"] == pytest.approx(3e-3)
     assert r.l0 == pytest.approx(l0) and r.quality == "draft"
-    assert controller.set("height", 50.0) == 3.0                 # clamped to the slider
+    # clamped to the slider, which reaches up to the preset's own height (U = 8 m/s)
+    assert controller.set("height", 50.0) == pytest.approx(8.0 ** 2 / (2 * G))
     assert controller.set("film", 1e-6) == pytest.approx(3 * l0)
     assert "scene.speed=" in overrides(controller.values, controller.sliders)
 
@@ -58,6 +59,23 @@ def test_drop_restarts_the_run(controller):
     assert not controller.drop()
     assert "film" in controller.error and controller.runs == 2
     assert controller.sim is sim and controller.time == t
+
+
+def test_the_first_drop_runs_at_the_presets_speed(controller):
+    fresh = LiveController("quick-2d", "draft", sets=SETS, start=lambda r: None)
+    assert fresh.resolve().speed == pytest.approx(8.0)      # not the booth range's 3 m
+
+
+def test_an_unstable_run_says_which_sliders_help():
+    """max_mach * c just above U: gravity takes the falling drop past it in the first step."""
+    c = LiveController("quick-2d", "draft", sets=SETS + ["numerics.max_mach=0.2000001"])
+    assert c.drop()
+    c.advance(0.0)
+    assert c.unstable and c.status == "unstable" and c.finished
+    assert c.error.startswith("unstable at t = ") and "max_mach" in c.error
+    assert c.error.endswith("try a thicker film, a smaller drop or a lower fall height")
+    assert len(c.error) < 300                  # the panel shows it whole
+    assert c.advance(0.0) == 0
 
 
 @pytest.fixture

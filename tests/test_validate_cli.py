@@ -116,6 +116,23 @@ def test_validate_ctrl_c_writes_the_finished_rows(tmp_path, capsys, ran, fake_ba
     assert "VALIDATION.md not rewritten" in capsys.readouterr().err
 
 
+def test_validate_ctrl_c_before_any_row_replaces_the_older_report(tmp_path, capsys,
+                                                                   monkeypatch, fake_backend):
+    """Interrupted before the first case finished: validation.md is this run's, marked, with
+    no row, not an earlier run's left as if it were this one's."""
+    (tmp_path / "validation.md").write_text("an earlier run\n| base | 1 |")
+    (tmp_path / "validation.csv").write_text("an earlier run")
+
+    def run_suite(selected, quick, variants, on_row):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(runner, "run_suite", run_suite)
+    assert main(["validate", "hydrostatic-2d", "--out", str(tmp_path)]) == 130
+    md = (tmp_path / "validation.md").read_text()
+    assert "Interrupted (Ctrl-C)" in md and "an earlier run" not in md and "| base |" not in md
+    assert "an earlier run" not in (tmp_path / "validation.csv").read_text()
+    assert _strict((tmp_path / "validation.json").read_text())["cases"] == []
+
+
 def test_validate_help_names_every_variant_the_code_runs(capsys):
     assert main(["validate", "--help"]) == 0
     text = " ".join(capsys.readouterr().out.split())

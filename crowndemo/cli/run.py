@@ -6,6 +6,7 @@ import time
 
 from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
+from ..core.health import InstabilityError
 from ..core.params import ParameterError
 from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, add_sequence_options,
                      load_presets, print_summary, run_result, simulate, start_backend)
@@ -62,8 +63,13 @@ def _run(args) -> int:
                       f"{scene.counts()['fluid']:,} fluid of {len(scene.pos):,} particles, arch "
                       f"{be.resolved}, {be.precision}; running to {r.t_end * 1e3:g} ms ({how})",
                       file=sys.stderr, flush=True)
-            run = simulate(sim, r.t_end, args.quiet, r.frame_times(), args.max_steps, stop=stop,
-                           first_label="first step" + ("" if reused else " (compiling)"))
+            try:
+                run = simulate(sim, r.t_end, args.quiet, r.frame_times(), args.max_steps,
+                               stop=stop,
+                               first_label="first step" + ("" if reused else " (compiling)"))
+            except InstabilityError as e:
+                return _unstable(r, e, results, [x.name for x in resolved[i + 1:]],
+                                 len(resolved) > 1, args)
             counts = sim.counts()
             s = r.scene
             first = run["first_step_s"] or 0.0
@@ -104,6 +110,21 @@ def _run(args) -> int:
     elif len(results) > 1:
         print(f"{len(results)} runs in {time.perf_counter() - t_all:.2f} s")
     return 130 if stop.requested else 0
+
+
+def _unstable(r, e, results: list, left: list, chain: bool, args) -> int:
+    """A preset of the list went unstable: the runs before it are reported as usual (with
+    --json, in the list, followed by this one's step, time and cause), the error names the
+    preset and the presets not run; exit status 3."""
+    if args.json:
+        results.append({"preset": r.name, "file": r.label, "quality": r.quality,
+                         "unstable": {"step": e.step, "time_s": e.time, "what": e.what,
+                                      "binding": e.binding, "message": str(e)}})
+        print(strictjson.dumps(results[0] if len(results) == 1 else results))
+    print(f"{PROG}: {r.name + ': ' if chain else ''}{e}", file=sys.stderr)
+    if left:
+        print(f"{PROG}: not run: {', '.join(left)}", file=sys.stderr)
+    return 3
 
 
 def register(sub, common) -> None:

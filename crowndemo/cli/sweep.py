@@ -171,7 +171,8 @@ def register(sub, common) -> None:
     p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
                    help=SET_HELP)
     p.add_argument("--out", type=path_argument, metavar="DIR",
-                   help="folder for the map (default: reports/)")
+                   help="folder for the map (default: reports/ at the repository root, "
+                        "wherever the command runs)")
     p.add_argument("--record", action="store_true",
                    help="also write docs/regime.md and docs/regime.png (linked from "
                         "VALIDATION.md)")

@@ -139,18 +139,19 @@ def _run(args, names, table, found, say) -> None:
         verdicts.run_all(quality=args.quality, on_row=verdict_line)
 
 
-def _write(out, header, rows, stab, verd) -> dict:
-    """The report files in ``out``. The cases' report (validation.md, .csv and the plot) is
-    replaced as a whole (report.write_all removes a plot it could not draw). stability.md
-    and verdicts.md of runs that did not run them are left, each headed by its own run's
-    command and date (a quick subset must not delete an hour-long run's report)."""
+def _write(out, header, rows, stab, verd, ran: dict) -> dict:
+    """The report files in ``out`` of the groups this run ran (``ran``), even with no row
+    (interrupted before the first finished: the header says so). The cases' report
+    (validation.md, .csv and the plot) is replaced as a whole (report.write_all removes a
+    plot it could not draw). The reports of groups it did not run are left, each headed by
+    its own run's command and date (a quick subset must not delete an hour-long run's)."""
     from ..validate import report, stability, verdicts
 
     os.makedirs(out, exist_ok=True)
-    paths = report.write_all(rows, out, header) if rows else {}
+    paths = report.write_all(rows, out, header) if ran["cases"] else {}
     for key, items, md in (("stability", stab, stability.markdown),
                            ("verdicts", verd, verdicts.markdown)):
-        if items:
+        if ran[key]:
             paths[key] = os.path.join(out, f"{key}.md")
             with open(paths[key], "w") as f:
                 f.write("\n".join(header + ["", md(items), ""]))
@@ -193,7 +194,7 @@ def _validate(args, argv) -> int:
               f"date {result['date']}.", "", f"Command: `{result['command']}`"]
     if interrupted:
         header += ["", INTERRUPTED]
-    paths = _write(out, header, rows, stab, verd)
+    paths = _write(out, header, rows, stab, verd, ran)
     result["files"] = paths
     with open(os.path.join(out, "validation.json"), "w") as f:
         report.dump_json(result, f)

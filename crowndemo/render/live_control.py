@@ -8,6 +8,7 @@ restart with the same compiled model reuses the simulator, its kernels and its f
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Callable, Dict, List, Optional, Tuple
@@ -42,14 +43,30 @@ def session_starter() -> Callable:
     return lambda resolved: session.load(resolved.build_scene())
 
 
+def preset_height(base) -> float:
+    """The fall height of a resolved preset: its scene.height, else U^2 / (2 g) (inf
+    without gravity, which live mode refuses)."""
+    s, g = base.scene, base.scene["gravity"]
+    return s.get("height", s["speed"] ** 2 / (2 * g) if g > 0 else math.inf)
+
+
+def unstable_advice(e: InstabilityError) -> str:
+    """The panel's line for a run that went unstable: when, what broke, and which sliders
+    help (a thin film under a big drop from high up throws a splash faster than c = 5 U)."""
+    return (f"unstable at t = {e.time * 1e3:.3g} ms: {e.what}; try a thicker film, a smaller "
+            "drop or a lower fall height")
+
+
 def sliders_for(base) -> Tuple[Slider, ...]:
     """The sliders' ranges for a resolved base preset: film and drop at least 3 particle
     spacings across (what the config layer demands), the drop narrower than half the floor."""
     s, l0 = base.scene, base.l0
+    # the booth's range of heights, reaching up to the preset's own (3.26 m for 8 m/s)
+    height = (HEIGHT_RANGE[0], max(HEIGHT_RANGE[1], preset_height(base)))
     film = (3 * l0, max(4 * s["film"], 6 * l0))
     drop = (max(3 * l0, 0.5 * s["drop"]), min(2 * s["drop"], 0.5 * s["floor"]))
     return (Slider("height", "scene.height", {"en": "fall height", "ja": "落下高さ"},
-                   *HEIGHT_RANGE, "m", 1.0),
+                   *height, "m", 1.0),
             Slider("film", "scene.film", {"en": "film thickness", "ja": "水膜の厚さ"},
                    *film, "mm", 1e3),
             Slider("drop", "scene.drop", {"en": "drop diameter", "ja": "水滴の直径"},
@@ -79,7 +96,7 @@ class LiveController:
             raise PresetError(self.base.label, "scene.gravity", g,
                               "live mode sets a fall height, which needs gravity", "> 0")
         s = self.base.scene
-        self.values = {"height": s.get("height", s["speed"] ** 2 / (2 * g)),
+        self.values = {"height": preset_height(self.base),
                        "film": s["film"], "drop": s["drop"]}
         for sl in self.sliders:
             self.values[sl.name] = sl.clamp(self.values[sl.name])
@@ -144,9 +161,10 @@ class LiveController:
                 if self.finished or time.perf_counter() >= end:
                     break
         except InstabilityError as e:
-            self.status, self.error, self.unstable = "unstable", str(e), True
+            self.status, self.error, self.unstable = "unstable", unstable_advice(e), True
         return steps
 
 
 __all__ = ["LiveController", "Slider", "sliders_for", "overrides", "session_starter",
+           "preset_height", "unstable_advice",
            "DEFAULT_PRESET", "HEIGHT_RANGE"]
