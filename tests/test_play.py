@@ -210,6 +210,12 @@ def test_out_may_not_be_a_recordings_own_video(recordings, tmp_path, capsys):
     assert not (recordings / "green" / "video.mp4").exists()
     (red / "reel.mp4").unlink()
     assert play(recordings, red / "reel.mp4", "red") == 0          # another name is fine
+    # a video*.mp4 in a new folder of the recordings would be played next time as a recording
+    new = recordings / "reel" / "video.mp4"
+    assert play(recordings, new, "red") == 2
+    err = capsys.readouterr().err
+    assert "would be played next time as a recording named reel" in err
+    assert not new.parent.exists()
 
 
 def make_frameless(root, name):

@@ -72,6 +72,15 @@ def test_validate_list_refuses_case_names(capsys, no_backend):
     assert "--list takes no case names (got nosuchcase)" in capsys.readouterr().err
 
 
+def test_validate_list_json(capsys, no_backend):
+    assert main(["validate", "--list", "--json"]) == 0
+    data = _strict(capsys.readouterr().out)
+    table = cases.all_cases(full=True)
+    assert [c["name"] for c in data["cases"]] == list(table)
+    assert data["cases"][0]["scales"] == list(table[data["cases"][0]["name"]].scales)
+    assert "verdicts" in data["groups"] and "3m-drop" in data["groups"]["verdicts"]
+
+
 def test_validate_runs_a_case_named_twice_once(tmp_path, ran, fake_backend):
     argv = ["validate", "laplace-2d", "hydrostatic-2d", "laplace-2d", "hydrostatic-2d",
             "--out", str(tmp_path)]

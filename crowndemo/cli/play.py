@@ -1,6 +1,7 @@
 """``crowndemo play``: the booth loop over recordings, in a window or into a video file."""
 from __future__ import annotations
 
+import fnmatch
 import os
 import shlex
 import sys
@@ -51,6 +52,20 @@ def _check_not_a_recording_file(out: str, folders) -> None:
                          "reel would replace it; give a file outside the recordings' folders")
 
 
+def _check_not_a_new_recording(out: str, root: str) -> None:
+    """UsageError when ``out`` would be a video*.mp4 in a folder of the recordings folder:
+    the next play would take that folder for a recording (a video without metadata)."""
+    from ..render.player import OWN_VIDEOS
+    target = os.path.realpath(out)
+    folder = os.path.dirname(target)
+    if os.path.dirname(folder) == os.path.realpath(root) and \
+            fnmatch.fnmatch(os.path.basename(target), OWN_VIDEOS):
+        raise UsageError(f"--out {out}: a {os.path.basename(target)} in a folder of {root}/ "
+                         f"would be played next time as a recording named "
+                         f"{os.path.basename(folder)}; give another name or a file outside "
+                         f"{root}/")
+
+
 def _no_recordings(root: str, frameless) -> str:
     """Why there is nothing to play in ``root``, and how to record something that plays."""
     from ..record import recordings_root
@@ -98,6 +113,7 @@ def _play(args, argv) -> int:
         here = player.list_recordings(args.dir) + frameless
         _check_not_a_recording_file(args.out, [r.path for r in found]
                                     + [os.path.join(args.dir, n) for n in here])
+        _check_not_a_new_recording(args.out, args.dir)
     player.warn_frameless(frameless)
     chosen = player.select(found, args.partial)
     if not chosen:

@@ -76,12 +76,23 @@ def _machine() -> str:
     return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
-def _list(table, extra) -> int:
+def _list(table, extra, as_json: bool = False) -> int:
+    """The cases and groups, a line each (``as_json``: one JSON object)."""
+    from .. import strictjson
     from ..validate import stability, verdicts
 
     if extra:
         raise UsageError(f"--list takes no case names (got {', '.join(extra)}); allowed: "
                          f"'{PROG} validate --list' alone")
+    if as_json:
+        print(strictjson.dumps({
+            "cases": [{"name": c.name, "quantity": c.quantity, "reference": c.reference,
+                       "resolution": c.resolution, "scales": list(c.scales),
+                       "quick": list(c.quick), "variants": list(c.variants)}
+                      for c in table.values()],
+            "groups": {"stability": list(stability.cases(True)),
+                       "verdicts": list(verdicts.SEED)}}))
+        return 0
     for c in table.values():
         print(f"{c.name:<22} {c.quantity}; reference: {c.reference}; {c.resolution} = "
               f"{', '.join(f'{s:g}' for s in c.scales)} (quick: "
@@ -164,7 +175,7 @@ def _validate(args, argv) -> int:
 
     table = cases_mod.all_cases(full=True)
     if args.list:
-        return _list(table, args.cases)
+        return _list(table, args.cases, args.json)
     names = _names(args, table)
     out = os.path.join(repo_root(), "reports") if args.out is None else args.out
     require_folder("--out", out)
