@@ -70,13 +70,8 @@ LATTICE_RANGES = {"l0": ("l0", RUNG_KEYS["l0"]), "re_ratio": ("re_ratio", SCENE_
 
 def in_range(field: Field, value) -> bool:
     """Whether ``value`` is a finite number inside a schema Field's range."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not math.isfinite(value):
-        return False
-    lo, hi = field.lo, field.hi
-    low = lo is not None and (value < lo or (value == lo and not field.lo_incl))
-    high = hi is not None and (value > hi or (value == hi and not field.hi_incl))
-    return not (low or high)
+    return (not isinstance(value, bool) and isinstance(value, (int, float))
+            and math.isfinite(value) and field.in_range(value))
 
 
 def check_range(key: str, value, field: Field, source: str = "command line") -> None:
@@ -237,7 +232,7 @@ def _preset_facts(r, tp) -> Dict:
     numerics = {key: (None if isinstance(v, float) and math.isinf(v) else v)
                 for key, v in asdict(r.numerics).items() if key != "allow_unsafe_dt"}
     return {
-        "preset": r.name, "file": r.label, "extends_chain": _files(r.doc.chain),
+        "preset": r.name, "file": r.label, "extends_chain": r.doc.files,
         "quality": r.quality,
         "title": r.title, "description": r.description, "dim": r.dim,
         "scene": {"floor_m": s["floor"], "film_m": h, "drop_m": D, "speed_m_s": U,
@@ -280,12 +275,6 @@ def _preset_facts(r, tp) -> Dict:
                               crown_base_radius(s["t_end"] - impact, U, D, h)},
         "left_out": est["particles"]["left_out"],
     }
-
-
-def _files(chain) -> list:
-    """A Document's chain of preset files, base first, without the ``--set`` layer."""
-    from ..config.overrides import SOURCE
-    return [label for label in chain if label != SOURCE]
 
 
 def _speed_in_c(v: float, c: float) -> str:

@@ -1,7 +1,6 @@
 """``crowndemo play``: the booth loop over recordings, in a window or into a video file."""
 from __future__ import annotations
 
-import fnmatch
 import os
 import shlex
 import sys
@@ -55,11 +54,10 @@ def _check_not_a_recording_file(out: str, folders) -> None:
 def _check_not_a_new_recording(out: str, root: str) -> None:
     """UsageError when ``out`` would be a video*.mp4 in a folder of the recordings folder:
     the next play would take that folder for a recording (a video without metadata)."""
-    from ..render.player import OWN_VIDEOS
+    from ..render.player import owner_of
     target = os.path.realpath(out)
     folder = os.path.dirname(target)
-    if os.path.dirname(folder) == os.path.realpath(root) and \
-            fnmatch.fnmatch(os.path.basename(target), OWN_VIDEOS):
+    if os.path.dirname(folder) == os.path.realpath(root) and owner_of(out, [folder]):
         raise UsageError(f"--out {out}: a {os.path.basename(target)} in a folder of {root}/ "
                          f"would be played next time as a recording named "
                          f"{os.path.basename(folder)}; give another name or a file outside "

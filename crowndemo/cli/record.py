@@ -111,7 +111,6 @@ def _check_options(folder: Path, saved: Optional[dict], r, args) -> None:
     now = recording_options(args)
     if not isinstance(saved, dict) or not all(k in saved for k in now):
         return          # a recording made before the options were kept: not checked
-    saved = {**saved, "resolution": list(saved["resolution"])}
     diff = [f"{k.replace('_', '-')} {_shown(saved[k])} there, {_shown(now[k])} now"
             for k in MATCHED if saved[k] != now[k]]
     if diff:

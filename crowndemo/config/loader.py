@@ -122,6 +122,11 @@ class Document:
     chain: List[str] = field(default_factory=list)     # source labels, base first
     ranks: Dict[str, int] = field(default_factory=dict)
 
+    @property
+    def files(self) -> List[str]:
+        """The chain of preset files, base first, without the ``--set`` layer."""
+        return [label for label in self.chain if label != SET_SOURCE]
+
     def source_of(self, key_path) -> str:
         """The source that wrote a key (or the nearest enclosing one), else this file."""
         p = tuple(key_path)

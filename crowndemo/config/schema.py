@@ -53,6 +53,12 @@ class Field:
     keys: Optional[Dict[str, "Field"]] = None
     allow_inf: bool = False
 
+    def in_range(self, v) -> bool:
+        """Whether the number ``v`` lies within lo and hi (each end as the field says)."""
+        low = self.lo is not None and (v < self.lo or (v == self.lo and not self.lo_incl))
+        high = self.hi is not None and (v > self.hi or (v == self.hi and not self.hi_incl))
+        return not (low or high)
+
     def allowed(self) -> str:
         if self.kind in ("number", "int"):
             parts = []
@@ -244,9 +250,7 @@ def _check(f: Field, v, path, doc: Document):
 
 
 def _range(f: Field, v, path, doc: Document) -> None:
-    low = f.lo is not None and (v < f.lo or (v == f.lo and not f.lo_incl))
-    high = f.hi is not None and (v > f.hi or (v == f.hi and not f.hi_incl))
-    if low or high:
+    if not f.in_range(v):
         _fail(doc, path, v, "out of range", f.allowed())
 
 

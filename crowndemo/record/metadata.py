@@ -13,7 +13,6 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Optional
 
-from ..config.merge import SET_SOURCE
 from ..strictjson import finite_or_none
 from .files import CHECKPOINT, PathLike, atomic_write_json
 from .runlog import RunLog
@@ -43,7 +42,7 @@ def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoin
     return finite_or_none({
         "format": FORMAT,
         "complete": status == COMPLETE, "status": status, "stopped_by": log.stopped_by,
-        "preset": resolved.name, "file": resolved.label, "extends_chain": [c for c in resolved.doc.chain if c != SET_SOURCE],
+        "preset": resolved.name, "file": resolved.label, "extends_chain": resolved.doc.files,
         "quality": resolved.quality, "dim": resolved.dim, "title": resolved.title,
         "parameters": {"values": resolved.values, "crown": kw,
                        "sources": {k: {"key": key, "file": src}
