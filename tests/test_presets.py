@@ -334,8 +334,9 @@ def test_bad_set_gives_one_clear_error(capsys, item, fragments):
 
 def test_a_slow_drop_too_fine_for_its_sound_speed_names_l0(capsys):
     """c from the capillary speed, which grows as 1/sqrt(l0): the acoustic dt l0/c falls as
-    l0^1.5, and the finest l0 named gives dt = 1e-8 s: at 3e-7 m dt = 2.56e-9 s, so l0 >=
-    3e-7 (1e-8 / 2.56e-9)^(2/3) = 7.44e-7 m."""
+    l0^1.5, and the finest l0 named gives dt = 1e-8 s. Water (sigma 0.0728 N/m, rho 998
+    kg/m^3) at 3e-7 m: c = 5 sqrt(2.25 sigma / (rho l0)) = 117 m/s, dt = l0/c = 2.56e-9 s
+    (acoustic safety 1), so l0 >= 3e-7 (1e-8 / 2.56e-9)^(2/3) = 7.44e-7 m."""
     argv = ["info", "quick-2d", "--set", "quality.draft.l0=3e-7", "--set", "scene.speed=0.01"]
     assert main(argv) == 2
     err = capsys.readouterr().err
