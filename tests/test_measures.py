@@ -15,8 +15,8 @@ from crowndemo.core import FLUID, GONE, simulator_for
 from crowndemo.scenes import hydrostatic_tank
 from crowndemo.scenes.drop import mode2_decay, mode2_omega
 from crowndemo.validate.cases import fluid_pressure_profile
-from crowndemo.validate.observables import (LINK_L0, lattice_cohesion_pressure, liquid_body,
-                                            mechanical_pressure, surge_front)
+from crowndemo.core.lattice import lattice_cohesion_pressure
+from crowndemo.validate.observables import LINK_L0, liquid_body, mechanical_pressure, surge_front
 
 SQ2, SQ3 = math.sqrt(2.0), math.sqrt(3.0)
 

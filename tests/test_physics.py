@@ -8,8 +8,8 @@ from crowndemo.core import (FLUID, InstabilityError, Numerics, ParameterError, s
 from crowndemo.scenes import circularity, dam_break, hydrostatic_tank, square_patch
 from crowndemo.validate.cases import dam_break_fronts, fluid_pressure_profile
 from crowndemo.scenes.drop import resting_drop
-from crowndemo.validate.observables import (fit_time_origin, lattice_cohesion_pressure,
-                                            mechanical_pressure)
+from crowndemo.core.lattice import lattice_cohesion_pressure
+from crowndemo.validate.observables import fit_time_origin, mechanical_pressure
 
 RHO, G = 998.0, 9.81
 

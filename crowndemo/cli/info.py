@@ -10,7 +10,9 @@ from typing import Dict
 from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..config.schema import LIQUID_KEYS, RUNG_KEYS, SCENE_KEYS, Field
-from ..core.params import ParameterError
+from ..core import timestep
+from ..core.health import starts_too_fast
+from ..core.params import SOUND_SPEED_FACTOR, WATER, ParameterError
 from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, load_preset)
 
 
@@ -36,7 +38,8 @@ n0 and lambda0 come from a perfect lattice (S13), C from the cut-plane energy ba
 
 # the lattice options of `info` without a preset, and their defaults
 INFO_LATTICE = {"dim": ("--dim", None), "l0": ("--l0", None), "re_ratio": ("--re-ratio", 2.1),
-                "sigma": ("--sigma", 0.0728), "rho": ("--rho", 998.0), "nu": ("--nu", 1.0e-6),
+                "sigma": ("--sigma", WATER["sigma"]), "rho": ("--rho", WATER["rho"]),
+                "nu": ("--nu", WATER["nu"]),
                 "speed": ("--speed", 1.0), "sound_speed": ("--sound-speed", None)}
 
 
@@ -101,18 +104,6 @@ def floor3(x: float) -> float:
     return math.floor(x / step * (1 + 1e-12)) * step
 
 
-def _l0_for_dt(name: str, physics, numerics, dt: float) -> float:
-    """The l0 at which the ``name`` limit (core/timestep.py) equals ``dt``."""
-    if name == "courant":
-        return dt * physics.v_max / numerics.courant
-    if name == "acoustic":
-        return dt * physics.c / numerics.acoustic
-    if name == "viscous":
-        return math.sqrt(dt * physics.nu / numerics.viscous)
-    assert name == "capillary", name
-    return ((dt / numerics.capillary) ** 2 * 2.0 * math.pi * physics.sigma / physics.rho) ** (1 / 3)
-
-
 def _check_dt_floor(physics, numerics, lim: Dict[str, float]) -> None:
     """Refuse a lattice whose time step a preset's run would refuse (below DT_FLOOR,
     config/resolve.py): name l0 and the finest spacing that passes or, where no l0 in its
@@ -128,7 +119,7 @@ def _check_dt_floor(physics, numerics, lim: Dict[str, float]) -> None:
         return
     why = (f"below, dt = {lim[name]:.3g} s (the {name} limit) is under the {DT_FLOOR:g} s "
            "that a run accepts")
-    need = max(_l0_for_dt(k, physics, numerics, DT_FLOOR) for k in lim)
+    need = max(timestep.l0_at_dt(k, physics, numerics, DT_FLOOR) for k in lim)
     l0_max = RUNG_KEYS["l0"].hi
     if need <= l0_max:
         raise ParameterError("l0", physics.l0, f">= {ceil3(need):.3g} m and <= {l0_max:g} m "
@@ -140,7 +131,6 @@ def _check_dt_floor(physics, numerics, lim: Dict[str, float]) -> None:
 
 
 def _info_lattice(args) -> int:
-    from ..core import timestep
     from ..core.lattice import LatticeConstants
     from ..core.params import Model, Numerics, Physics
 
@@ -149,8 +139,7 @@ def _info_lattice(args) -> int:
                       rho=args.rho, nu=args.nu, sigma=args.sigma,
                       sound_speed=args.sound_speed).validate("info")
     numerics = Numerics()
-    if numerics.max_mach * physics.c <= physics.v_max:
-        # a run stops at once when a particle outruns max_mach * c (core/health.py)
+    if starts_too_fast(physics.v_max, physics.c, numerics.max_mach):
         raise ParameterError("sound_speed", physics.c,
                              f"> speed / max_mach = {physics.v_max / numerics.max_mach:.4g} m/s "
                              f"(a run stops when a particle is faster than max_mach * c, "
@@ -169,7 +158,7 @@ def _info_lattice(args) -> int:
     out = {"dim": d, "l0": physics.l0, "re_ratio": physics.re_ratio, "re": lat.re,
            "rho": physics.rho, "nu": physics.nu, "sigma": physics.sigma,
            "speed": physics.v_max, "sound_speed": physics.c,
-           "sound_speed_source": "given" if args.sound_speed is not None else "5 x speed",
+           "sound_speed_source": "given" if args.sound_speed is not None else f"{SOUND_SPEED_FACTOR:g} x speed",
            "n0": lat.n0, "lambda0": lat.lambda0, "lambda0_over_l0_sq": lat.lambda0 / lat.l0 ** 2,
            "C": lat.C, "mass": lat.mass,
            "mass_unit": "kg" if d == 3 else "kg/m (per unit depth)",
@@ -215,6 +204,7 @@ def _preset_facts(r, tp) -> Dict:
     from ..core.step import max_particles
     from ..record.recorder import frame_times
     from ..scenes.crown import crown_base_radius
+    from ..validate.verdicts import cossali
 
     ph, s, liq = r.physics, r.scene, r.liquid
     lat = LatticeConstants.compute(ph.dim, ph.l0, ph.re_ratio, ph.rho, ph.sigma)
@@ -222,12 +212,8 @@ def _preset_facts(r, tp) -> Dict:
     lim, dt = est["limits_s"], est["dt_s"]
     ties = [k for k, v in lim.items() if v <= dt * (1 + 1e-9)]
     U, D, h = s["speed"], s["drop"], s["film"]
-    mu = liq["rho"] * liq["nu"]
-    we = liq["rho"] * U * U * D / liq["sigma"] if liq["sigma"] > 0 else math.inf
+    splash = cossali(U, D, h, liq["rho"], liq["nu"], liq["sigma"])
     re_num = U * D / liq["nu"] if liq["nu"] > 0 else math.inf
-    oh = mu / math.sqrt(liq["rho"] * liq["sigma"] * D) if liq["sigma"] > 0 else math.inf
-    k = we * oh ** -0.4 if mu > 0 and liq["sigma"] > 0 else math.inf
-    k_splash = 2100.0 + 5880.0 * (h / D) ** 1.44
     impact = s["gap"] / U
     numerics = {key: (None if isinstance(v, float) and math.isinf(v) else v)
                 for key, v in asdict(r.numerics).items() if key != "allow_unsafe_dt"}
@@ -249,7 +235,7 @@ def _preset_facts(r, tp) -> Dict:
         "mass_unit": "kg" if ph.dim == 3 else "kg/m (per unit depth)",
         "sound_speed_m_s": ph.c,
         "sound_speed_source": s.get("sound_speed_source") or (
-            "given" if s.get("sound_speed") is not None else "5 x speed"),
+            "given" if s.get("sound_speed") is not None else f"{SOUND_SPEED_FACTOR:g} x speed"),
         "numerics": numerics, "model": Model.describe(r.model),
         "limits_s": {key: lim.get(key) for key in ("courant", "approach", "acoustic",
                                                     "viscous", "capillary", "dt_max")
@@ -268,9 +254,9 @@ def _preset_facts(r, tp) -> Dict:
         "throughput": {"fluid_particle_steps_per_s": tp.rate,
                        "all_particle_steps_per_s": tp.rate_total,
                        "bytes_per_particle": tp.bytes_per_particle, "source": tp.source},
-        "dimensionless": {"weber": we, "reynolds": re_num, "ohnesorge": oh,
-                          "cossali_K": k, "cossali_K_splash": k_splash,
-                          "splash_predicted": k > k_splash,
+        "dimensionless": {"weber": splash["We"], "reynolds": re_num, "ohnesorge": splash["Oh"],
+                          "cossali_K": splash["K"], "cossali_K_splash": splash["K_threshold"],
+                          "splash_predicted": splash["splash"],
                           "crown_base_radius_at_t_end_m":
                               crown_base_radius(s["t_end"] - impact, U, D, h)},
         "left_out": est["particles"]["left_out"],
@@ -408,13 +394,13 @@ def register(sub, common) -> None:
                    help="without PRESET: particle spacing [m], > 0 and <= 0.01")
     p.add_argument("--re-ratio", type=float, help="re / l0 (default: 2.1)")
     p.add_argument("--sigma", type=float,
-                   help="surface tension [N/m] (default: 0.0728, water; 0 turns it off)")
-    p.add_argument("--rho", type=float, help="density [kg/m^3] (default: 998)")
+                   help=f"surface tension [N/m] (default: {WATER['sigma']:g}, water; 0 turns it off)")
+    p.add_argument("--rho", type=float, help=f"density [kg/m^3] (default: {WATER['rho']:g})")
     p.add_argument("--nu", type=float,
-                   help="kinematic viscosity [m^2/s] (default: 1e-6; 0 turns it off)")
+                   help=f"kinematic viscosity [m^2/s] (default: {WATER['nu']:g}; 0 turns it off)")
     p.add_argument("--speed", type=float,
                    help="expected maximum speed v [m/s] for the Courant limit (default: 1)")
     p.add_argument("--sound-speed", type=float, default=None,
-                   help="artificial sound speed c [m/s] (default: 5 x speed, S8)")
+                   help=f"artificial sound speed c [m/s] (default: {SOUND_SPEED_FACTOR:g} x speed, S8)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=lambda a, argv: _info(a))

@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
 from ..core import timestep
-from ..core.params import Model, Numerics, ParameterError, Physics
+from ..core.health import starts_too_fast
+from ..core.params import SOUND_SPEED_FACTOR, Model, Numerics, ParameterError, Physics
 from .errors import MISSING, PresetError
 from .loader import Document
 from .merge import DEFAULT_SOURCE
@@ -257,15 +258,14 @@ def resolve(doc: Document, quality: str) -> Resolved:
             fail("sound_speed", scene["sound_speed"], why,
                  f"<= {numerics.acoustic * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
         elif dt_name == "acoustic":
+            u_max = numerics.acoustic * l0 / (SOUND_SPEED_FACTOR * DT_FLOOR)
             fail("speed", scene.get("height", scene["speed"]), why,
-                 f"U <= {numerics.acoustic * l0 / (5 * DT_FLOOR):.4g} m/s at l0 = {l0:g} m "
-                 "(c = 5 U)")
+                 f"U <= {u_max:.4g} m/s at l0 = {l0:g} m (c = {SOUND_SPEED_FACTOR:g} U)")
         elif dt_name == "viscous":
-            fail("l0", l0, why, f">= {math.sqrt(DT_FLOOR * liquid['nu'] / numerics.viscous):.3g}"
-                 f" m at nu = {liquid['nu']:g} m^2/s")
+            need = timestep.l0_at_dt("viscous", physics, numerics, DT_FLOOR)
+            fail("l0", l0, why, f">= {need:.3g} m at nu = {liquid['nu']:g} m^2/s")
         elif dt_name == "capillary":
-            need = ((DT_FLOOR / numerics.capillary) ** 2 * 2 * math.pi * liquid["sigma"]
-                    / liquid["rho"]) ** (1 / 3)
+            need = timestep.l0_at_dt("capillary", physics, numerics, DT_FLOOR)
             fail("l0", l0, why, f">= {need:.3g} m at sigma = {liquid['sigma']:g} N/m")
         else:
             fail("numerics.dt_max", numerics.dt_max, why, f">= {DT_FLOOR:g} s")
@@ -277,9 +277,6 @@ def resolve(doc: Document, quality: str) -> Resolved:
     return Resolved(doc, quality, values, dim, l0, scene, liquid, numerics, physics, model, where)
 
 
-SOUND_SPEED_FACTOR = 5.0     # c = 5 v_max (method.md S8): (v/c)^2 = 4 % compression
-
-
 def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> Tuple[float, str]:
     """The speeds a drop on a film reaches whatever its impact speed U (m/s), which c = 5 U
     would not cover when U is small: the fall, sqrt(2 g (gap + D)) (a drop let go at the
@@ -289,8 +286,7 @@ def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> Tuple[fl
     liquid. With c = 5 U alone a 0.5 m/s drop at l0 = 0.1 mm (c = 2.5 m/s) was compressed
     26 % by that stress and went unstable at its 6th step. No shipped preset reaches this
     floor (tests/test_presets.py), so their c stays 5 U. Returns the larger and its name."""
-    from ..core.lattice import LatticeConstants
-    from ..validate.observables import lattice_cohesion_pressure
+    from ..core.lattice import LatticeConstants, lattice_cohesion_pressure
     fall = math.sqrt(2.0 * scene["gravity"] * (scene["gap"] + scene["drop"]))
     capillary = 0.0
     if liquid["sigma"] > 0:
@@ -314,7 +310,7 @@ def _check_mach(scene: dict, numerics: Numerics, physics: Physics, fail) -> None
     """The run stops as soon as a particle is faster than max_mach * c (core.health), and the
     drop starts at U and gains speed as it falls: max_mach * c must exceed U."""
     U, c, mach = scene["speed"], physics.c, numerics.max_mach
-    if mach * c > U:
+    if not starts_too_fast(U, c, mach):
         return
     why = (f"the run would stop at its first step: it stops when a particle is faster than "
            f"numerics.max_mach * c = {mach:g} x {c:.4g} m/s, and the drop starts at "

@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Dict, Optional, Tuple
 
-from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, WALL_MODELS
+from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, WALL_MODELS, WATER
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
 
@@ -33,7 +33,7 @@ LANGUAGES = ("en", "ja")
 # near 20 C (density 1030 kg/m^3, viscosity about 2 mPa s, surface tension about 0.045 N/m);
 # approximate, they vary with fat content and temperature.
 LIQUIDS: Dict[str, Dict[str, float]] = {
-    "water": {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728},
+    "water": dict(WATER),
     "milk": {"rho": 1030.0, "nu": 2.0e-6, "sigma": 0.045},
 }
 
@@ -114,7 +114,7 @@ SCENE_KEYS = {
                   lo_incl=True, default=1.0e-3),
     "liquid": Field("liquid", "the liquid of the drop and the film", default="water"),
     "gravity": number("gravitational acceleration, along -z", "m/s^2", 0, 100, lo_incl=True,
-                      default=9.81),
+                      default=GRAVITY),
     "t_end": number("simulated time", "s", 0, 10, required=True),
     "frame_interval": number("time between recorded frames", "s", 0, 10),
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",

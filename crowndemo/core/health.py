@@ -202,9 +202,9 @@ class Health:
         what = None
         if report.nonfinite:
             what = f"{report.nonfinite} fluid particles have non-finite position, velocity or pressure"
-        elif report.max_speed > max_mach * sound_speed:
+        elif report.max_speed > speed_limit(sound_speed, max_mach):
             what = (f"maximum speed {report.max_speed:.4g} m/s exceeds max_mach * c = "
-                    f"{max_mach * sound_speed:.4g} m/s (weak compressibility lost)")
+                    f"{speed_limit(sound_speed, max_mach):.4g} m/s (weak compressibility lost)")
         elif report.max_density_excess > max_density_excess:
             what = (f"number-density excess n/n0 - 1 = {report.max_density_excess:.3g} exceeds "
                     f"the limit {max_density_excess:g}")
@@ -215,6 +215,17 @@ class Health:
             remedy = "enlarge the domain, or check the scene's walls and initial speeds"
         if what:
             raise InstabilityError(step, time, what, binding, dt, remedy)
+
+
+def speed_limit(sound_speed: float, max_mach: float) -> float:
+    """The speed past which a run stops, weak compressibility lost (S8): max_mach * c."""
+    return max_mach * sound_speed
+
+
+def starts_too_fast(speed: float, sound_speed: float, max_mach: float) -> bool:
+    """A scene that starts at ``speed`` would stop at its first step: a drop gains speed as
+    it falls, so reaching the limit at the start is enough."""
+    return speed >= speed_limit(sound_speed, max_mach)
 
 
 def count_kinds(kind: np.ndarray) -> Dict[str, int]:

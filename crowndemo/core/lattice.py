@@ -98,3 +98,17 @@ class LatticeConstants:
         n0, lam = n0_lambda0(dim, l0, re)
         return cls(dim, l0, re, n0, lam, surface_tension_coefficient(dim, l0, re, sigma),
                    rho * l0 ** dim)
+
+
+def lattice_cohesion_pressure(dim: int, l0: float, re: float, C: float) -> float:
+    """The potential model's stress in a perfect lattice (method.md S22, force per the §4 sign
+    note): (1/(2 d l0^d)) sum_j -C (r - l0)(r - re) r over the neighbours within re. Negative
+    (a tension) for C < 0; inside a resting liquid the equation-of-state pressure balances it,
+    so P_EOS = -this + the Laplace jump. In 2D it is -2.25 sigma/l0 and in 3D -3.04 sigma/l0
+    at re = 2.1 l0: the jump (sigma/R) is a small difference of large terms."""
+    reach = int(np.ceil(re / l0))
+    axis = np.arange(-reach, reach + 1)
+    pts = np.stack(np.meshgrid(*[axis] * dim, indexing="ij"), -1).reshape(-1, dim) * l0
+    r = np.linalg.norm(pts, axis=1)
+    r = r[(r > 0) & (r < re)]
+    return float(np.sum(-C * (r - l0) * (r - re) * r) / (2 * dim * l0 ** dim))

@@ -13,6 +13,11 @@ GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i;
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
 COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; terms.py)
 
+# the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
+WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
+GRAVITY = 9.81                                            # m/s^2
+SOUND_SPEED_FACTOR = 5.0    # c = 5 v_max (method.md S8): (v/c)^2 = 4 % compression
+
 
 class ParameterError(ValueError):
     """A parameter out of its allowed range, reported before any kernel runs."""
@@ -28,15 +33,16 @@ class Physics:
     l0: float                       # initial particle spacing [m]
     v_max: float                    # expected maximum speed of the scene [m/s] (S5-S8)
     re_ratio: float = 2.1           # re / l0 (S10)
-    rho: float = 998.0              # density [kg/m^3]
-    nu: float = 1.0e-6              # kinematic viscosity [m^2/s]
-    sigma: float = 0.0728           # surface tension [N/m]
-    gravity: float = 9.81           # along minus the last axis [m/s^2]
+    rho: float = WATER["rho"]       # density [kg/m^3]
+    nu: float = WATER["nu"]         # kinematic viscosity [m^2/s]
+    sigma: float = WATER["sigma"]   # surface tension [N/m]
+    gravity: float = GRAVITY        # along minus the last axis [m/s^2]
     sound_speed: Optional[float] = None   # None: c = 5 v_max (S8)
 
     @property
     def c(self) -> float:
-        return self.sound_speed if self.sound_speed is not None else 5.0 * self.v_max
+        return (self.sound_speed if self.sound_speed is not None
+                else SOUND_SPEED_FACTOR * self.v_max)
 
     @property
     def re(self) -> float:

@@ -41,6 +41,21 @@ def limits(physics: Physics, numerics: Numerics, model: Model, speed: float,
     return out
 
 
+def l0_at_dt(name: str, physics: Physics, numerics: Numerics, dt: float) -> float:
+    """The l0 at which the ``name`` limit of ``limits`` (at speed v_max, not the relative
+    speed) equals ``dt``: each limit inverted for l0."""
+    if name == "courant":
+        return dt * physics.v_max / numerics.courant
+    if name == "acoustic":
+        return dt * physics.c / numerics.acoustic
+    if name == "viscous":
+        return math.sqrt(dt * physics.nu / numerics.viscous)
+    if name == "capillary":
+        return ((dt / numerics.capillary) ** 2 * 2.0 * math.pi * physics.sigma
+                / physics.rho) ** (1.0 / 3.0)
+    raise ValueError(f"no l0 sets the {name} limit")
+
+
 def choose(physics: Physics, numerics: Numerics, model: Model, speed: float,
            relative_speed: Optional[float] = None) -> Tuple[float, str]:
     """dt = the smallest limit (or the user's fixed dt), and the name of what binds."""

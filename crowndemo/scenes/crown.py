@@ -13,7 +13,7 @@ from typing import Optional
 
 import numpy as np
 
-from ..core.params import Numerics, Physics
+from ..core.params import GRAVITY, WATER, Numerics, Physics
 from ..core.lattice import wall_layers
 from .base import Scene, assemble, container_walls, floor_face, lattice_block, particle_faces
 
@@ -36,8 +36,8 @@ def reach_radius(t_end: float, U: float, D: float, h: float, gap: float) -> floa
 
 def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 1.0e-2,
           speed: float = 8.0, gap: float = 1.0e-3, floor: float = 0.09, t_end: float = 4.0e-3,
-          trim: bool = True, numerics: Optional[Numerics] = None, rho: float = 998.0,
-          nu: float = 1.0e-6, sigma: float = 0.0728, gravity: float = 9.81,
+          trim: bool = True, numerics: Optional[Numerics] = None, rho: float = WATER["rho"],
+          nu: float = WATER["nu"], sigma: float = WATER["sigma"], gravity: float = GRAVITY,
           sound_speed: Optional[float] = None, re_ratio: float = 2.1) -> Scene:
     """Drop on a film. ``floor`` is the side of the square container floor (the width of the
     slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0."""

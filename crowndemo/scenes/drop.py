@@ -8,10 +8,9 @@ from typing import Optional
 
 import numpy as np
 
-from ..core.params import Numerics, Physics
+from ..core.params import WATER, Numerics, Physics
 from .base import Scene, assemble, lattice_block
 
-WATER = dict(rho=998.0, nu=1.0e-6, sigma=0.0728)
 COMPRESSION = 0.01   # the sound speed keeps the cohesion's compression ~1 % (see drop_sound_speed)
 
 

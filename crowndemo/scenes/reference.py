@@ -7,11 +7,10 @@ from typing import Optional
 
 import numpy as np
 
-from ..core.params import Numerics, Physics
+from ..core.params import GRAVITY, WATER, Numerics, Physics
 from ..core.lattice import wall_layers
 from .base import Scene, assemble, container_walls, lattice_block, particle_faces
 
-WATER = dict(rho=998.0, nu=1.0e-6, sigma=0.0728)
 
 
 def _walls_faces(dim: int) -> list:
@@ -20,11 +19,11 @@ def _walls_faces(dim: int) -> list:
 
 
 def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, depth: float = 0.04,
-                     nu: float = 1.0e-6, t_end: float = 0.5, numerics: Optional[Numerics] = None,
+                     nu: float = WATER["nu"], t_end: float = 0.5, numerics: Optional[Numerics] = None,
                      **physics) -> Scene:
     """A column of water of height ``depth`` at rest in a container ``width`` wide (square
     floor in 3D); P(z) = rho g (H - z). v_max = sqrt(2 g H) sets c = 5 v_max (S8)."""
-    g = physics.pop("gravity", 9.81)
+    g = physics.pop("gravity", GRAVITY)
     v_max = physics.pop("v_max", math.sqrt(2.0 * g * depth))
     ph = Physics(dim=dim, l0=l0, v_max=v_max, gravity=g,
                  **{**WATER, "sigma": 0.0, "nu": nu, **physics})
@@ -46,7 +45,7 @@ def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float =
               **physics) -> Scene:
     """A water column a wide and 2a high at the left end of a tank ``length`` a long (and
     ``channel`` a wide in 3D); Martin & Moyce's surge front z/a against t sqrt(2g/a)."""
-    g = physics.pop("gravity", 9.81)
+    g = physics.pop("gravity", GRAVITY)
     v_max = physics.pop("v_max", math.sqrt(2.0 * g * 2.0 * a))
     ph = Physics(dim=dim, l0=l0, v_max=v_max, gravity=g, **{**WATER, "sigma": 0.0, **physics})
     across = [channel * a] * (dim - 2)
@@ -64,7 +63,8 @@ def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float =
                     info)
 
 
-def square_patch(dim: int = 2, side: float = 2.0e-3, l0: float = 1.0e-4, sigma: float = 0.0728,
+def square_patch(dim: int = 2, side: float = 2.0e-3, l0: float = 1.0e-4,
+                 sigma: float = WATER["sigma"],
                  nu: float = 1.0e-4, v_max: float = 1.0, t_end: float = 0.03,
                  numerics: Optional[Numerics] = None, **physics) -> Scene:
     """A square (cube) of liquid at rest without gravity: surface tension rounds it up and the

@@ -13,6 +13,7 @@ from typing import Callable, Dict, List, Optional, Tuple
 import numpy as np
 
 from ..core import FLUID, Numerics, simulator_for
+from ..core.params import GRAVITY, WATER
 from ..scenes import dam_break, hydrostatic_tank
 from ..scenes.crown import crown_base_radius
 from ..scenes.drop import oscillating_drop, resting_drop
@@ -20,7 +21,7 @@ from . import oscillation
 from .observables import fit_time_origin, mechanical_pressure, surge_front
 from .crown_metrics import measure as crown_measure
 
-G, RHO = 9.81, 998.0
+G, RHO = GRAVITY, WATER["rho"]
 
 # Martin & Moyce (1952), column a x 2a: (T = t sqrt(2 g / a), Z = front / a), method.md §7
 MARTIN_MOYCE = ((0.832, 1.217), (1.219, 1.474), (1.997, 2.292), (2.547, 2.995), (3.345, 4.134),

@@ -73,20 +73,6 @@ def _pair_geometry(p: np.ndarray, re: float):
     return d, np.where(inside, r, 1.0), inside
 
 
-def lattice_cohesion_pressure(dim: int, l0: float, re: float, C: float) -> float:
-    """The potential model's stress in a perfect lattice (method.md S22, force per the §4 sign
-    note): (1/(2 d l0^d)) sum_j -C (r - l0)(r - re) r over the neighbours within re. Negative
-    (a tension) for C < 0; inside a resting liquid the equation-of-state pressure balances it,
-    so P_EOS = -this + the Laplace jump. In 2D it is -2.25 sigma/l0 and in 3D -3.04 sigma/l0
-    at re = 2.1 l0: the jump (sigma/R) is a small difference of large terms."""
-    reach = int(np.ceil(re / l0))
-    axis = np.arange(-reach, reach + 1)
-    pts = np.stack(np.meshgrid(*[axis] * dim, indexing="ij"), -1).reshape(-1, dim) * l0
-    r = np.linalg.norm(pts, axis=1)
-    r = r[(r > 0) & (r < re)]
-    return float(np.sum(-C * (r - l0) * (r - re) * r) / (2 * dim * l0 ** dim))
-
-
 def mechanical_pressure(pos: np.ndarray, l0: float, re: float, n0: float, rho: float,
                         C: float, mass: float, c2: float, beta: float, dt: float) -> np.ndarray:
     """Per-particle virial (Irving-Kirkwood) pressure (1/(2 d l0^d)) sum_j (r_i - r_j) . F_ij

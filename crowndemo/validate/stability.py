@@ -17,6 +17,7 @@ from typing import Callable, Dict, List, Optional
 import numpy as np
 
 from ..core import GONE, InstabilityError, ParameterError, simulator_for
+from ..core.params import GRAVITY, WATER
 from ..scenes import Scene, crown
 
 ENERGY_GROWTH = 0.02     # E_end > (1 + this) E_start with no source counts as growth
@@ -63,7 +64,7 @@ class StabilityRow:
 def _kw(**over) -> dict:
     """The crown keywords of the suite's base: quick's drop as a 2D slice at D/l0 = 20."""
     kw = dict(dim=2, l0=L0_2D, film=1.2e-3, drop=4.0e-3, speed=8.0, gap=4.0e-4, floor=0.09,
-              rho=998.0, nu=1.0e-6, sigma=0.0728, gravity=9.81)
+              gravity=GRAVITY, **WATER)
     kw.update(over)
     return kw
 

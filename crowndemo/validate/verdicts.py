@@ -25,20 +25,26 @@ def observation_times(t_end: float) -> List[float]:
     return sorted({t for t in SEED_FRAMES if t < t_end - 1e-12} | {t_end})
 
 
+def splash_threshold(D: float, h: float) -> float:
+    """Cossali et al.'s (1997) splash threshold 2100 + 5880 delta^1.44, delta = h/D (method.md
+    §7)."""
+    return 2100.0 + 5880.0 * (h / D) ** 1.44
+
+
 def cossali(U: float, D: float, h: float, rho: float, nu: float, sigma: float) -> dict:
-    """K = We Oh^-0.4 against 2100 + 5880 delta^1.44 (Cossali et al. 1997, method.md §7)."""
-    we = rho * U * U * D / sigma
-    oh = rho * nu / math.sqrt(rho * sigma * D)
-    k = we * oh ** -0.4
-    threshold = 2100.0 + 5880.0 * (h / D) ** 1.44
+    """K = We Oh^-0.4 against ``splash_threshold`` (Cossali et al. 1997, method.md §7). With no
+    surface tension or no viscosity K is infinite (We or Oh^-0.4 is)."""
+    we = rho * U * U * D / sigma if sigma > 0 else math.inf
+    oh = rho * nu / math.sqrt(rho * sigma * D) if sigma > 0 else math.inf
+    k = we * oh ** -0.4 if nu > 0 and sigma > 0 else math.inf
+    threshold = splash_threshold(D, h)
     return {"We": we, "Oh": oh, "K": k, "K_threshold": threshold, "splash": k > threshold}
 
 
 def threshold_speed(D: float, h: float, rho: float, nu: float, sigma: float) -> float:
     """The impact speed at which K reaches Cossali's threshold for a film h (m/s)."""
     oh = rho * nu / math.sqrt(rho * sigma * D)
-    k_th = 2100.0 + 5880.0 * (h / D) ** 1.44
-    return math.sqrt(k_th * oh ** 0.4 * sigma / (rho * D))
+    return math.sqrt(splash_threshold(D, h) * oh ** 0.4 * sigma / (rho * D))
 
 
 @dataclass
