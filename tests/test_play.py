@@ -90,6 +90,16 @@ def test_completeness_without_metadata(tmp_path):
     assert not player.open_recording(str(d)).complete
 
 
+def test_damaged_metadata_is_named(tmp_path):
+    """A metadata.json that is not a recording's (a JSON list, or not JSON) is an error that
+    names the file, not a recording silently taken as one without metadata."""
+    d = make_recording(tmp_path, "damaged", (200, 200, 200), 2)
+    for text in ("[1, 2]", "{not json"):
+        (d / "metadata.json").write_text(text)
+        with pytest.raises(player.PlayError, match="metadata.json: cannot read"):
+            player.open_recording(str(d))
+
+
 def test_play_errors(recordings, tmp_path):
     assert play(recordings, tmp_path / "x.mp4", "nosuch") == 2
     assert play(recordings, tmp_path / "x.mp4", "broken") == 2      # only incomplete ones

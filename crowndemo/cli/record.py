@@ -165,25 +165,21 @@ def _check_folders(root: Path, names: List[str], args) -> None:
 def _resume_point(r, folder: Path, args):
     """The checkpoint --resume continues from, checked before Taichi starts (the render sink,
     made next, would remove the video of the recording), with the recording's options."""
-    from ..record import METADATA, RecordError
-    from ..record.metadata import read
-    from ..record.recorder import resume_point
+    from ..record import RecordError
+    from ..record.recorder import readable_metadata, resume_point
     try:
         saved = resume_point(r, folder, args.precision)
     except RecordError as e:
         raise UsageError(str(e)) from None
-    try:
-        meta = read(folder / METADATA) or {}
-    except (OSError, ValueError):
-        meta = {}          # the checkpoint alone decides (resume_point)
-    _check_options(folder, meta.get("recording_options"), r, args)
+    _check_options(folder, readable_metadata(folder).get("recording_options"), r, args)
     return saved
 
 
 def _record(args) -> int:
     from ..control import Session
     from ..interrupt import StopRequest
-    from ..record import RecordError, recording_dir, recordings_root
+    from ..record import METADATA, RecordError, recording_dir, recordings_root
+    from ..record.metadata import read as read_metadata
     from ..record.recorder import AlreadyComplete, record_preset
 
     if args.max_steps is not None and args.max_steps < 1:
@@ -248,7 +244,7 @@ def _record(args) -> int:
                 if isinstance(e, RecordError):
                     raise UsageError(str(e)) from None
                 raise
-            meta = json.loads((folder / "metadata.json").read_text())
+            meta = read_metadata(folder / METADATA)
             if render:
                 meta = _add_render_timing(folder, meta, render[0], res)
             out.append({"folder": str(folder), **meta})
@@ -303,14 +299,14 @@ def _ending(r, res, folder: Path, args, left: List[str]) -> Optional[int]:
 def _add_render_timing(folder: Path, meta: dict, sink, res) -> dict:
     """Render time per frame set against simulation time per frame (stepping only), written
     into metadata.json: rendering must not dominate a recording."""
-    from ..record.files import atomic_write_json
+    from ..record.files import METADATA, atomic_write_json
 
     timing = sink.timing()
     frames = max(timing["frames"], 1)
     timing["simulation_seconds_per_frame"] = res.sim.stats.wall_seconds / frames
     timing["outputs"] = {k: os.path.basename(v) for k, v in sink.outputs.items()}
     meta["render"] = timing
-    atomic_write_json(folder / "metadata.json", meta)
+    atomic_write_json(folder / METADATA, meta)
     return meta
 
 

@@ -6,7 +6,9 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import BinaryIO, Callable, Optional, Tuple, Union
+from typing import BinaryIO, Callable, Dict, Optional, Tuple, Union
+
+from .sinks import COMPLETE
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -15,16 +17,35 @@ CHECKPOINT = "checkpoint.npz"
 SNAPSHOTS = "snapshots"
 
 
-# what rendering writes into a recording's folder (render/sink.py)
-RENDERED = ("frames/frame_*.png", "video*.mp4", "preview*.gif")
+# what rendering writes into a recording's folder (render/sink.py): FRAMES/frame_NNNNN.png,
+# and when the recording closes video.mp4 and preview.gif, or video.partial.mp4 and
+# preview.partial.gif when it did not complete (``video_names``)
+FRAMES = "frames"
+FRAME_GLOB = "frame_*.png"
+VIDEO_GLOB = "video*.mp4"
+PREVIEW_GLOB = "preview*.gif"
+VIDEO = "video.mp4"
 
 
-def remove_rendered(folder: PathLike) -> int:
-    """Delete the rendered frames, videos and previews in ``folder``; returns how many."""
-    gone = [p for pattern in RENDERED for p in Path(folder).glob(pattern)]
+def video_names(status: str) -> Dict[str, str]:
+    """The video and preview names for a recording that closed with ``status``."""
+    tag = "" if status == COMPLETE else ".partial"
+    return {"video": f"video{tag}.mp4", "preview": f"preview{tag}.gif"}
+
+
+def remove_rendered(folder: PathLike, keep_frames: bool = False) -> int:
+    """Delete the rendered frames (unless ``keep_frames``), videos and previews in ``folder``;
+    returns how many."""
+    patterns = [VIDEO_GLOB, PREVIEW_GLOB] + ([] if keep_frames else [f"{FRAMES}/{FRAME_GLOB}"])
+    gone = [p for pattern in patterns for p in Path(folder).glob(pattern)]
     for p in gone:
         p.unlink()
     return len(gone)
+
+
+def rendered_frames(folder: PathLike) -> list:
+    """The rendered frames of the recording in ``folder``, in order (paths as strings)."""
+    return sorted(str(p) for p in Path(folder, FRAMES).glob(FRAME_GLOB))
 
 
 def recordings_root() -> Path:
@@ -72,15 +93,8 @@ def _try_writing(folder: Path) -> Optional[Tuple[Path, str]]:
 
 
 def frame_name(index: int, suffix: str = ".npz") -> str:
+    """The file of frame ``index``: a snapshot (.npz) or a rendered frame (.png)."""
     return f"frame_{index:05d}{suffix}"
-
-
-def frame_index(path: PathLike) -> int:
-    """The index in ``frame_00042.npz`` (ValueError for another name)."""
-    stem = Path(path).stem
-    if not stem.startswith("frame_"):
-        raise ValueError(f"{path}: not a frame file (frame_NNNNN)")
-    return int(stem[len("frame_"):])
 
 
 def atomic_write(path: PathLike, write: Callable[[BinaryIO], None]) -> None:

@@ -78,12 +78,13 @@ def _other_parameters(path: Path, saved: dict, now: dict) -> None:
                           "or record without --resume")
 
 
-def _metadata(path: Path) -> Optional[dict]:
-    """metadata.json, or None when it is missing or unreadable (the checkpoint decides)."""
+def readable_metadata(folder: PathLike) -> dict:
+    """The recording's metadata.json; {} when it is missing or unreadable (for a resume the
+    checkpoint decides)."""
     try:
-        return read_metadata(path)
+        return read_metadata(Path(folder) / METADATA) or {}
     except (OSError, ValueError):
-        return None
+        return {}
 
 
 def resume_point(resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint:
@@ -92,8 +93,8 @@ def resume_point(resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint
     when there is no checkpoint or either was made with other parameters."""
     folder = Path(out_dir)
     now = fingerprint(resolved, precision)
-    meta = _metadata(folder / METADATA)
-    if meta and meta.get("complete") is True:
+    meta = readable_metadata(folder)
+    if meta.get("complete") is True:
         _other_parameters(folder / METADATA, meta.get("fingerprint") or {}, now)
         raise AlreadyComplete(folder, meta)
     try:
@@ -226,5 +227,5 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     return result
 
 
-__all__ = ["record_preset", "resume_point", "RecordResult", "RecordError", "AlreadyComplete",
+__all__ = ["record_preset", "resume_point", "readable_metadata", "RecordResult", "RecordError", "AlreadyComplete",
            "fingerprint", "frame_times"]

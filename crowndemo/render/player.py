@@ -14,7 +14,6 @@ from __future__ import annotations
 import fnmatch
 import glob
 import itertools
-import json
 import os
 import sys
 import time
@@ -24,6 +23,10 @@ from typing import Dict, Iterator, List, Optional, Sequence, Tuple
 import numpy as np
 from PIL import Image
 
+from ..record.files import (FRAME_GLOB, FRAMES, METADATA, VIDEO, VIDEO_GLOB, rendered_frames,
+                            video_names)
+from ..record.metadata import read as read_metadata
+from ..record.sinks import COMPLETE, INTERRUPTED
 from . import video
 from .captions import effective_lang, mark, title_card
 from .window import close_window, open_window
@@ -33,7 +36,6 @@ CARD_SECONDS = 3.0
 # --card-seconds: 0 shows no title cards; a minute is already far longer than a booth card
 # needs, and a huge or non-finite one never gets to the recordings (or cannot be counted).
 CARD_RANGE = (0.0, 60.0)
-OWN_VIDEOS = "video*.mp4"         # the videos the frame sink writes into a recording's folder
 NO_FRAMES = "no frames (recorded with --no-render)"
 MARKER = {"en": "INCOMPLETE RECORDING", "ja": "未完了の記録"}
 
@@ -60,23 +62,20 @@ class Recording:
 
 
 def _read_metadata(path: str) -> Dict:
-    meta_path = os.path.join(path, "metadata.json")
-    if not os.path.isfile(meta_path):
-        return {}
+    """The recording's metadata.json ({} without one); PlayError when it is damaged."""
+    meta_path = os.path.join(path, METADATA)
     try:
-        with open(meta_path, encoding="utf-8") as f:
-            meta = json.load(f)
+        return read_metadata(meta_path) or {}
     except (OSError, ValueError) as e:
         raise PlayError(f"{meta_path}: cannot read ({e})") from None
-    return meta if isinstance(meta, dict) else {}
 
 
 def _is_complete(meta: Dict, path: str) -> bool:
     if "status" in meta:
-        return meta["status"] == "complete"
+        return meta["status"] == COMPLETE
     if "complete" in meta:
         return bool(meta["complete"])
-    return os.path.isfile(os.path.join(path, "video.mp4"))
+    return os.path.isfile(os.path.join(path, VIDEO))
 
 
 def _preset_texts(name: str, meta: Dict) -> Tuple[object, object]:
@@ -108,15 +107,15 @@ def open_recording(spec: str, root: str = DEFAULT_ROOT) -> Recording:
     name = os.path.basename(os.path.normpath(path))
     meta = _read_metadata(path)
     complete = _is_complete(meta, path)
-    frames = sorted(glob.glob(os.path.join(path, "frames", "frame_*.png")))
+    frames = rendered_frames(path)
     vid = None
     if not frames:
-        names = ["video.mp4"] + ([] if complete else ["video.partial.mp4"])
+        names = [VIDEO] + ([] if complete else [video_names(INTERRUPTED)["video"]])
         vid = next((os.path.join(path, n) for n in names
                     if os.path.isfile(os.path.join(path, n))), None)
         if vid is None:
             why = (f"{NO_FRAMES}; record it again without --no-render to play it" if meta
-                   else "no frames (frames/frame_*.png) and no video.mp4")
+                   else f"no frames ({FRAMES}/{FRAME_GLOB}) and no {VIDEO}")
             raise PlayError(f"{path}: {why}")
     title, description = _preset_texts(name, meta)
     return Recording(name, path, frames, vid, complete, title, description, meta)
@@ -127,8 +126,8 @@ def list_recordings(root: str = DEFAULT_ROOT) -> List[str]:
     if not os.path.isdir(root):
         return []
     return sorted(n for n in os.listdir(root)
-                  if glob.glob(os.path.join(root, n, "frames", "frame_*.png"))
-                  or glob.glob(os.path.join(root, n, OWN_VIDEOS)))
+                  if glob.glob(os.path.join(root, n, FRAMES, FRAME_GLOB))
+                  or glob.glob(os.path.join(root, n, VIDEO_GLOB)))
 
 
 def frameless_recordings(root: str = DEFAULT_ROOT) -> List[str]:
@@ -138,7 +137,7 @@ def frameless_recordings(root: str = DEFAULT_ROOT) -> List[str]:
         return []
     playable = set(list_recordings(root))
     return sorted(n for n in os.listdir(root) if n not in playable
-                  and os.path.isfile(os.path.join(root, n, "metadata.json")))
+                  and os.path.isfile(os.path.join(root, n, METADATA)))
 
 
 def warn_frameless(names: Sequence[str]) -> None:
@@ -156,7 +155,7 @@ def owner_of(out: str, folders: Sequence[str]) -> Optional[Tuple[str, str]]:
     target = os.path.realpath(out)
     for folder in folders:
         if os.path.dirname(target) == os.path.realpath(folder) and \
-                fnmatch.fnmatch(os.path.basename(target), OWN_VIDEOS):
+                fnmatch.fnmatch(os.path.basename(target), VIDEO_GLOB):
             return folder, os.path.basename(target)
     return None
 

@@ -9,24 +9,14 @@ It times itself: ``frame_seconds`` (render, caption and PNG of each frame), ``re
 """
 from __future__ import annotations
 
-import glob
 import os
 import time as _time
 from typing import Dict, List, Optional
 
+from ..record.files import FRAMES, frame_name, remove_rendered, rendered_frames, video_names
 from . import video
 from .renderer import Renderer
 from .view import PresetView
-
-COMPLETE = "complete"
-FRAME_NAME = "frame_{:05d}.png"
-
-
-def output_names(status: str) -> Dict[str, str]:
-    """The video and preview names for a recording that closed with ``status``."""
-    tag = "" if status == COMPLETE else ".partial"
-    return {"video": f"video{tag}.mp4", "preview": f"preview{tag}.gif"}
-
 
 class FrameSink:
     def __init__(self, out_dir: str, view: PresetView, renderer: Optional[Renderer] = None,
@@ -36,11 +26,13 @@ class FrameSink:
         the frames of the interrupted recording that is being continued (the video is made
         from every frame in the folder)."""
         self.out_dir = out_dir
-        self.frames_dir = os.path.join(out_dir, "frames")
+        self.frames_dir = os.path.join(out_dir, FRAMES)
         self.view = view
         self.settings = view.settings
         os.makedirs(self.frames_dir, exist_ok=True)
-        self._clear_stale(keep_frames=resume)
+        # frames and videos of an earlier recording in the folder would mix with ours (a
+        # resumed recording keeps its frames: they are its own)
+        remove_rendered(out_dir, keep_frames=resume)
         self._owns_renderer = renderer is None     # a renderer passed in stays open
         self.renderer = renderer or Renderer(self.settings.resolution)
         if self.renderer.resolution != tuple(self.settings.resolution):
@@ -52,15 +44,6 @@ class FrameSink:
         self.outputs: Dict[str, str] = {}          # what close() wrote: video, preview
         self.status: Optional[str] = None
 
-    def _clear_stale(self, keep_frames: bool = False) -> None:
-        """Frames and videos of an earlier recording in the same folder would mix with ours
-        (a resumed recording keeps its frames: they are its own)."""
-        old = [] if keep_frames else glob.glob(os.path.join(self.frames_dir, "frame_*.png"))
-        old += [p for pattern in ("video*.mp4", "preview*.gif")
-                for p in glob.glob(os.path.join(self.out_dir, pattern))]
-        for p in old:
-            os.remove(p)
-
     @property
     def render_seconds(self) -> float:
         return sum(self.frame_seconds)
@@ -71,7 +54,7 @@ class FrameSink:
             raise RuntimeError("the frame sink is closed")
         start = _time.perf_counter()
         image = self.view.image(self.renderer, sim.state, time, index)
-        path = os.path.join(self.frames_dir, FRAME_NAME.format(index))
+        path = os.path.join(self.frames_dir, frame_name(index, ".png"))
         video.write_png(image, path)
         self.paths.append(path)
         self.frame_seconds.append(_time.perf_counter() - start)
@@ -91,12 +74,12 @@ class FrameSink:
         self.status = status
         if self._owns_renderer:
             self.renderer.close()
-        paths = sorted(glob.glob(os.path.join(self.frames_dir, "frame_*.png")))
+        paths = rendered_frames(self.out_dir)
         if not (self.settings.video and paths):
             return
         start = _time.perf_counter()
         try:
-            self._encode(paths, output_names(status))
+            self._encode(paths, video_names(status))
         except BaseException:
             self._mark_partial()
             raise
@@ -115,7 +98,7 @@ class FrameSink:
     def _mark_partial(self) -> None:
         """Encoding failed: what it wrote takes the partial names, so that nothing stands
         as complete."""
-        partial = output_names("failed")
+        partial = video_names("failed")
         for kind, path in list(self.outputs.items()):
             target = os.path.join(self.out_dir, partial[kind])
             if path != target:
@@ -129,4 +112,4 @@ class FrameSink:
                 "encode_seconds": self.encode_seconds}
 
 
-__all__ = ["FrameSink", "COMPLETE", "FRAME_NAME", "output_names"]
+__all__ = ["FrameSink"]
