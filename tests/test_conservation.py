@@ -11,7 +11,6 @@ under ``pmin`` drifts and spins up (README, "Validation status"), which this tes
 in ``sum``.
 """
 import numpy as np
-import pytest
 
 from crowndemo.core import Numerics, simulator_for
 from crowndemo.core.params import with_values

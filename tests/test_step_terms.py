@@ -84,7 +84,7 @@ def lattice_number_density(dim: int, spacing: float, re: float) -> float:
 @pytest.mark.parametrize("scale", [0.97, 1.0, 1.03])
 def test_density_pass_gives_the_equation_of_state(dim, scale):
     """The density pass (S9 in the step's kernel) and P = c^2 rho (n - n0)/n0 (S17), clamped
-    at 0 (a stretched lattice, n < n0, has P = 0; so does the block's surface layer, M3)."""
+    at 0 (a stretched lattice, n < n0, has P = 0; so does the block's surface layer)."""
     lat = Lattice(dim, scale)
     lat.load()
     lat.sim.pressure.density_and_pressure()
@@ -104,7 +104,7 @@ def test_density_pass_gives_the_equation_of_state(dim, scale):
     else:                                      # n0 itself rounds to P of a few mPa
         assert np.all(np.abs(p[lat.interior]) <= C * C * RHO * rtol())
     outer = np.max(np.abs(lat.ks), axis=1) == HALF[dim]
-    assert np.all(p[outer] == 0.0)             # the surface layer: n < beta n0 (M3)
+    assert np.all(p[outer] == 0.0)             # the surface layer: n < n0, clamped (S17)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

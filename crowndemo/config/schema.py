@@ -141,7 +141,8 @@ NUMERICS_KEYS = {
     "fixed_dt": number("a fixed time step instead of the adaptive one", "s", 1.0e-8, 1.0,
                        lo_incl=True),
     "pressure_gradient": Field("choice", "pressure-gradient form (M2)", choices=GRADIENT_FORMS),
-    "beta": number("free-surface threshold n < beta n0 (M3)", "", 0.5, 1.0, lo_incl=True,
+    "beta": number("free-surface threshold n < beta n0 (M3); with P clamped at 0 (n < n0 has "
+                   "P = 0 anyway) it changes no pressure", "", 0.5, 1.0, lo_incl=True,
                    hi_incl=False),
     "max_density_excess": number("abort when n/n0 - 1 exceeds this", "", 0, 10),
     "max_mach": number("abort when a speed exceeds this times c", "", 0, 10),

@@ -16,7 +16,7 @@ COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5;
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
 GRAVITY = 9.81                                            # m/s^2
-SOUND_SPEED_FACTOR = 5.0    # c = 5 v_max (method.md S8): (v/c)^2 = 4 % compression
+SOUND_SPEED_FACTOR = 5.0    # c = 5 v_max (method.md S8): Mach 0.2, density varies ~(v/c)^2 = 4 %
 
 
 class ParameterError(ValueError):

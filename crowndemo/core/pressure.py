@@ -21,7 +21,9 @@ from .state import DUMMY, FLUID, WALL
 
 @ti.func
 def equation_of_state(n, n0, c2, rho, beta):
-    """P = c^2 rho (n - n0)/n0 (S17), clamped at 0, and 0 on the free surface n < beta n0 (M3)."""
+    """P = c^2 rho (n - n0)/n0 (S17), clamped at 0, and 0 on the free surface n < beta n0 (M3).
+    With beta < 1 the free-surface rule changes nothing (n < beta n0 < n0 is clamped to 0
+    already); it is kept as the seed's method states it."""
     p = 0.0
     if n >= beta * n0:
         p = ti.max(c2 * rho * (n - n0) / n0, 0.0)
