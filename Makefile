@@ -9,8 +9,24 @@ STAMP := $(VENV)/.crowndemo-installed
 
 setup: $(STAMP) vulkan
 
+# Taichi 1.7.4 has wheels for Python 3.9-3.12 (pyproject's requires-python); a .venv left
+# without a working pip (an interrupted or failed set-up) is made again; Debian splits venv
+# into python3-venv, installed here when missing (as root).
 $(STAMP): pyproject.toml
-	test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; sys.exit(0 if (3, 9) <= v < (3, 13) else "error: crowndemo needs Python 3.9 to 3.12 (Taichi 1.7.4 has no wheels for %d.%d); run make with PYTHON=python3.12, say" % v)'
+	@$(PY) -m pip --version >/dev/null 2>&1 || { \
+	  rm -rf $(VENV); \
+	  $(PYTHON) -m venv $(VENV) 2>/dev/null || { \
+	    if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	      echo "installing python3-venv (Debian's venv module)"; \
+	      rm -rf $(VENV); \
+	      (apt-get install -y -qq python3-venv >/dev/null 2>&1 || \
+	       (apt-get update -qq && apt-get install -y -qq python3-venv >/dev/null)) && \
+	      $(PYTHON) -m venv $(VENV); \
+	    else \
+	      echo "error: $(PYTHON) -m venv failed: install python3-venv (Debian) and run make again"; \
+	      exit 1; \
+	    fi; }; }
 	$(PY) -m pip install --quiet --upgrade pip
 	$(PY) -m pip install --quiet -e '.[test]'
 	touch $(STAMP)

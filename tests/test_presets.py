@@ -21,6 +21,16 @@ def test_shipped_presets_are_listed():
     assert SHIPPED <= set(config.preset_names())
 
 
+def test_shipped_booth_playlist_names_shipped_presets():
+    """presets/booth.txt, the playlist of the README's examples, lists the seed's other scenes
+    (not 2m-drop, which the examples record first: a name listed twice is refused)."""
+    from crowndemo.config.playlist import read_playlist
+    names = [spec for spec, _ in read_playlist(str(config.presets_dir() / "booth.txt"))]
+    assert names == ["3m-drop", "20cm-drop", "thick-layer"]
+    for name in names:
+        schema.validate(config.load_document(name))
+
+
 @pytest.mark.parametrize("quality", config.QUALITIES)
 @pytest.mark.parametrize("name", sorted(SHIPPED))
 def test_every_preset_validates_at_every_quality(name, quality):

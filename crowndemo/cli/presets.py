@@ -93,7 +93,7 @@ def _presets(args) -> int:
         for q in config.QUALITIES:
             head += f"  {q.upper():<15}"
         print(f"presets in {config.display(folder)}{os.sep}: fluid particles and a rough run "
-              "time per quality on this machine")
+              "time per quality at the throughput of BENCHMARKS.md (--rate for yours)")
         print(head.rstrip())
         for row, title in zip(rows, titles):
             line = f"{row['name']:<{nw}}  {row['dim']}D   {_pad(title, tw)}"

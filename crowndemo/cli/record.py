@@ -20,7 +20,7 @@ examples:
   crowndemo record quick                          # recordings/quick/: frames + metadata.json
   crowndemo record 3m-drop --quality booth        # ~289k particles, 17 frames
   crowndemo record quick --then quick-2d          # one after another, one compiled session
-  crowndemo record 2m-drop --playlist booth.txt   # then the presets listed in the file
+  crowndemo record 2m-drop --playlist presets/booth.txt   # then the seed's other scenes
   crowndemo record 3m-drop --resume               # continue after Ctrl-C (same options)
   crowndemo record quick --set scene.t_end=5e-4 --checkpoint-every 4
 

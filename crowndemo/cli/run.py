@@ -18,7 +18,7 @@ examples:
   crowndemo run 3m-drop --quality booth             # the seed's first run, ~289k particles
   crowndemo run 3m-drop --set scene.speed=6 --set quality.draft.t_end=5e-4
   crowndemo run quick --then quick-2d 20cm-drop     # one after another, one process
-  crowndemo run quick --playlist booth.txt          # then the presets listed in a file
+  crowndemo run quick --playlist presets/booth.txt  # then the presets listed in a file
   crowndemo run my-preset.yaml                      # a file; it may `extends: 3m-drop`
   crowndemo run 2m-drop --arch cuda --quality seed  # ~11.7M particles, on a GPU
 

@@ -16,7 +16,7 @@ NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 SWEEP_EPILOG = """\
 examples:
   crowndemo sweep                                        # quick-2d: 3 films x 4 speeds
-  crowndemo sweep quick --film 0.8e-3 1.2e-3 --speed 2 5 8
+  crowndemo sweep quick --film 1.2e-3 2.4e-3 --speed 2 5 8
   crowndemo sweep 3m-drop --film 1e-3 3e-3 1e-2 --speed 2 5 8 --quality draft
   crowndemo sweep quick-2d --set scene.t_end=5e-4 --out /tmp/map
 

@@ -29,7 +29,7 @@ from .loader import Document
 QUALITIES = ("draft", "booth", "seed")
 LANGUAGES = ("en", "ja")
 
-# Named liquids. water: the seed's values (shared/docs/method.md §6). milk: typical whole milk
+# Named liquids. water: the seed's values (docs/method.md §6). milk: typical whole milk
 # near 20 C (density 1030 kg/m^3, viscosity about 2 mPa s, surface tension about 0.045 N/m);
 # approximate, they vary with fat content and temperature.
 LIQUIDS: Dict[str, Dict[str, float]] = {
