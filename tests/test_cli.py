@@ -58,6 +58,7 @@ def test_info_table(capsys):
     (["bench", "--preset", "nosuch-preset"], "nosuch-preset"),
     (["bench", "--preset", "quick", "--set", "scene.speed=-1"], "scene.speed"),
     (["bench", "--preset", "quick", "--max-steps", "0"], "max-steps"),
+    (["bench", "--preset", "quick", "--max-steps", "1"], "an integer >= 2"),
     (["bench", "--set", "numerics.allow_unsafe_dt=true"], "numerics.allow_unsafe_dt"),
     (["presets", "--rate", "0"], "--rate"),
     (["presets", "--rate", "-1"], "--rate"),
@@ -236,3 +237,23 @@ def test_json_is_strict_when_no_step_sets_a_dt_range(capsys):
     assert data["steps"] == 1 and data["dt_min_s"] is None and data["dt_max_s"] is None
     assert main(["scene", "dam-break", "--t-end", "1e-9", "--quiet"]) == 0
     assert "every step cut short to land on a frame time or the end" in capsys.readouterr().out
+
+
+def test_scene_summary_gives_the_units_of_its_sizes():
+    from crowndemo.cli.scene import _sizes
+    assert _sizes({"l0": 1e-3, "width": 0.04, "depth": 0.08, "nu": 1e-3, "t_end": 0.2}) == \
+        "width 0.04 m, depth 0.08 m, nu 0.001 m^2/s"
+    assert _sizes({"l0": 2e-3, "a": 0.03, "t_end": 0.1}) == "a 0.03 m"
+    assert _sizes({"l0": 1e-4, "side": 2e-3, "sigma": 0.0728}) == "side 0.002 m, sigma 0.0728 N/m"
+
+
+def test_first_step_line_allows_for_the_offline_cache(capsys):
+    """The first step compiles the kernels or loads them from Taichi's offline cache."""
+    import types
+
+    from crowndemo.cli.common import Progress
+    Progress(1.0, quiet=False)(types.SimpleNamespace(stats=types.SimpleNamespace(steps=1,
+                                                                                 time=0.0)))
+    err = capsys.readouterr().err
+    assert "first step (kernels compiled or loaded from the cache)" in err
+    assert "(compiling)" not in err

@@ -61,8 +61,13 @@ def test_info_lattice_refuses_an_infinite_dt():
     from crowndemo.cli.info import _check_dt_floor
     from crowndemo.core.params import Numerics, ParameterError, Physics
     physics = Physics(dim=2, l0=1e-3, v_max=1.0, nu=0.0, sigma=0.0)
-    with pytest.raises(ParameterError, match="v_max"):
+    with pytest.raises(ParameterError, match="speed"):
         _check_dt_floor(physics, Numerics(), {"courant": math.inf, "acoustic": math.inf})
+
+
+def test_info_lattice_speed_is_named_as_its_option(capsys):
+    err = _one_line_error(["info", "--dim", "3", "--l0", "1e-3", "--speed", "60"], capsys)
+    assert "error: speed = 60.0 is out of range" in err and "v_max" not in err
 
 
 def test_info_lattice_finest_l0_it_names_passes(capsys):

@@ -264,3 +264,16 @@ def test_recordings_without_frames(recordings, tmp_path, monkeypatch, capsys):
     assert len(list(read_video(str(out)))) == (card + 2) + (card + 3)   # green, red
     assert play(recordings, recordings / "dry" / "video.mp4") == 2     # would make it play
     assert not (recordings / "dry" / "video.mp4").exists()
+
+
+def test_misspelt_recording_name_suggests_the_closest(recordings, tmp_path, capsys):
+    assert play(recordings, tmp_path / "reel.mp4", "gren") == 2
+    err = capsys.readouterr().err
+    assert "no recording 'gren'" in err and "(did you mean 'green'?)" in err
+
+
+def test_summary_line_uses_singular_for_one(recordings, tmp_path, capsys):
+    assert play(recordings, tmp_path / "one.mp4", "red", "--loops", "1") == 0
+    assert "(1 recording x 1 loop)" in capsys.readouterr().err
+    assert play(recordings, tmp_path / "two.mp4", "red", "green", "--loops", "2") == 0
+    assert "(2 recordings x 2 loops)" in capsys.readouterr().err

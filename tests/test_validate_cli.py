@@ -72,6 +72,12 @@ def test_validate_list_refuses_case_names(capsys, no_backend):
     assert "--list takes no case names (got nosuchcase)" in capsys.readouterr().err
 
 
+def test_validate_misspelt_case_suggests_the_closest(capsys, no_backend):
+    assert main(["validate", "dam-brake-2d"]) == 2
+    assert "unknown case dam-brake-2d (did you mean 'dam-break-2d'?)" in \
+        capsys.readouterr().err
+
+
 def test_validate_list_json(capsys, no_backend):
     assert main(["validate", "--list", "--json"]) == 0
     data = _strict(capsys.readouterr().out)

@@ -163,8 +163,9 @@ def _bench_presets(args, argv: Sequence[str]) -> int:
         raise UsageError("--n and --compare apply to the tank block only, not with --preset "
                          "(a preset sets its own particles and numerics; use --set) "
                          "(see 'crowndemo bench --help')")
-    if args.max_steps is not None and args.max_steps < 1:
-        raise ParameterError("max_steps", args.max_steps, "an integer >= 1", "command line")
+    if args.max_steps is not None and args.max_steps < 2:
+        raise ParameterError("max_steps", args.max_steps, "an integer >= 2 (the first step "
+                             "is the warm-up, the rest are timed)", "command line")
     quality = args.quality or "booth"
     resolved = [config.load(spec, quality, args.sets) for spec in args.preset]
     start_backend(args)
@@ -212,7 +213,8 @@ def register(sub, common) -> None:
                         "block, a numerics value (numerics.KEY=VALUE)")
     p.add_argument("--max-steps", type=int, metavar="N",
                    help="stop each --preset run after N steps, at least 2: the first "
-                        "compiles, the rest are timed (a smoke test)")
+                        "compiles or loads the kernels from the cache, the rest are timed "
+                        "(a smoke test)")
     p.add_argument("--record", action="store_true",
                    help="append a section (machine, arch, date, command, table) to BENCHMARKS.md "
                         "at the repository root")

@@ -22,7 +22,8 @@ PROGRESS_EVERY_S = 2.0
 NUMERICS = Numerics()       # the core's defaults, shown in --help
 
 # command-line option for each parameter name that a ParameterError can carry
-OPTION_OF = {"dim": "--dim", "l0": "--l0", "v_max": "--speed", "re_ratio": "--re-ratio",
+OPTION_OF = {"dim": "--dim", "l0": "--l0", "v_max": "--speed", "speed": "--speed",
+             "re_ratio": "--re-ratio",
              "rho": "--rho", "nu": "--nu", "sigma": "--sigma", "sound_speed": "--sound-speed",
              "pressure_gradient": "--gradient", "t_end": "--t-end", "width": "--width",
              "depth": "--depth", "a": "--a", "side": "--side", "n": "--n", "steps": "--steps",
@@ -114,12 +115,16 @@ def fmt_counts(counts: Dict[str, int]) -> str:
 
 
 
+FIRST_STEP = "first step (kernels compiled or loaded from the cache)"
+
+
 class Progress:
     """A step callback: a progress line on stderr every ~2 s (simulated time, steps/s, ETA);
-    the first step of the process's run (it compiles the kernels) is timed apart."""
+    the first step of the process's run (it compiles the kernels or loads them from Taichi's
+    offline cache) is timed apart."""
 
     def __init__(self, t_end: float, quiet: bool, max_steps: Optional[int] = None,
-                 first_label: str = "first step (compiling)"):
+                 first_label: str = FIRST_STEP):
         self.t_end, self.quiet, self.max_steps = t_end, quiet, max_steps
         self.first_label = first_label
         self.started = time.perf_counter()
@@ -153,7 +158,7 @@ class Progress:
 def simulate(sim, t_end: float, quiet: bool, frame_times: Sequence[float] = (),
              max_steps: Optional[int] = None,
              on_frame: Optional[Callable[[object, int], None]] = None,
-             stop=None, first_label: str = "first step (compiling)") -> Dict:
+             stop=None, first_label: str = FIRST_STEP) -> Dict:
     """Run ``sim`` to ``t_end`` (or ``max_steps``, or until ``stop.requested``: Ctrl-C) with a
     progress line on stderr every ~2 s; returns the stats, the peak health figures, whether
     and why the run stopped early (stopped_by: max-steps | ctrl-c) and the first step's time."""
@@ -215,7 +220,8 @@ def print_summary(head: str, run: Dict, counts: Dict[str, int], sound_speed: flo
         print(f"  result      {obs['text']}")
     rate = stats.steps / stats.wall_seconds if stats.wall_seconds > 0 else math.nan
     print(f"  wall time   {setup_s + stats.wall_seconds:.2f} s (set-up {setup_s:.2f} s, "
-          f"stepping {stats.wall_seconds:.2f} s incl. compiling, {rate:.1f} steps/s)")
+          f"stepping {stats.wall_seconds:.2f} s incl. compiling or loading the kernels, "
+          f"{rate:.1f} steps/s)")
 
 
 PRESET_HELP = "a preset name (see 'crowndemo presets') or a path to a preset YAML file"

@@ -12,9 +12,9 @@ from .record import _recordings_option
 
 EXPORT_EPILOG = """\
 examples:
-  crowndemo export quick --vtk                     # recordings/quick -> recordings/quick/vtk/
-  crowndemo export 3m-drop --vtk --out /tmp/crown  # somewhere else
-  crowndemo export quick --vtk --recordings runs   # from runs/quick
+  crowndemo export quick                           # recordings/quick -> recordings/quick/vtk/
+  crowndemo export 3m-drop --out /tmp/crown        # somewhere else
+  crowndemo export quick --recordings runs         # from runs/quick
 
 Reads RECORDINGS/PRESET (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
 ./recordings): the frames listed in its metadata.json. When there is no recording, the
@@ -22,7 +22,8 @@ preset is recorded first, without rendering (as 'crowndemo record PRESET --no-re
 the same --quality, --set and backend options), then exported. An interrupted recording
 exports the frames it has and says how to resume it.
 
-Writes OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
+Writes, in the one format (VTK; --vtk is the default and may be left out),
+OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
 data: velocity, pressure, number_density, kind, id; 2D runs get z = 0) and OUT/PRESET.pvd
 (every frame with its time in s): open the .pvd in ParaView. frame_*.vtp files in OUT that
 are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk. All or
@@ -62,8 +63,6 @@ def _export(args) -> int:
     from ..record.sinks import INTERRUPTED
     from ..record.recorder import fingerprint, record_preset
 
-    if not args.vtk:
-        raise UsageError("choose a format: --vtk (ParaView .vtp + .pvd)")
     r = load_preset(args.preset, args)
     root = Path(args.recordings) if args.recordings else recordings_root()
     folder = recording_dir(r.name, root)
@@ -137,7 +136,8 @@ def register(sub, common) -> None:
                                    "preset first when there is no recording.")
     p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
     p.add_argument("--vtk", action="store_true",
-                   help="VTK XML: frame_NNNNN.vtp per frame and PRESET.pvd (the one format)")
+                   help="VTK XML: frame_NNNNN.vtp per frame and PRESET.pvd (the one format, "
+                        "and the default: may be left out)")
     p.add_argument("--out", type=path_argument, metavar="DIR",
                    help="output folder (default: RECORDINGS/PRESET/vtk)")
     p.add_argument("--recordings", type=path_argument, metavar="DIR",

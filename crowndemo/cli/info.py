@@ -67,7 +67,7 @@ def _info(args) -> int:
 LATTICE_RANGES = {"l0": ("l0", RUNG_KEYS["l0"]), "re_ratio": ("re_ratio", SCENE_KEYS["re_ratio"]),
                   "rho": ("rho", LIQUID_KEYS["rho"]), "nu": ("nu", LIQUID_KEYS["nu"]),
                   "sigma": ("sigma", LIQUID_KEYS["sigma"]),
-                  "speed": ("v_max", SCENE_KEYS["speed"]),
+                  "speed": ("speed", SCENE_KEYS["speed"]),
                   "sound_speed": ("sound_speed", SCENE_KEYS["sound_speed"])}
 
 
@@ -113,7 +113,7 @@ def _check_dt_floor(physics, numerics, lim: Dict[str, float]) -> None:
     name = min(lim, key=lim.get)
     if not math.isfinite(lim[name]):        # no nu, no sigma, and l0 / v overflows
         slowest = numerics.courant * physics.l0 / sys.float_info.max
-        raise ParameterError("v_max", physics.v_max, f"> {slowest * 1.01:.3g} m/s (slower, "
+        raise ParameterError("speed", physics.v_max, f"> {slowest * 1.01:.3g} m/s (slower, "
                              "the Courant limit l0 / v overflows: dt would be infinite)", "info")
     if lim[name] >= DT_FLOOR:
         return

@@ -94,6 +94,11 @@ def _check_args(args) -> None:
         args.dir = os.fspath(recordings_root())
 
 
+def _count(n: int, word: str) -> str:
+    """'1 loop', '3 loops'."""
+    return f"{n} {word}{'' if n == 1 else 's'}"
+
+
 def _play(args, argv) -> int:
     from ..render import player
     from ..render.window import check_available
@@ -126,7 +131,8 @@ def _play(args, argv) -> int:
     if args.headless:
         n = player.play_to_file(frames, args.out, args.fps)
         print(f"{PROG}: wrote {args.out}: {n} frames, {n / args.fps:.1f} s at {args.fps:g} fps "
-              f"({len(chosen)} recordings x {args.loops} loops)", file=sys.stderr)
+              f"({_count(len(chosen), 'recording')} x {_count(args.loops, 'loop')})",
+              file=sys.stderr)
         return 0
     player.play_in_window(frames, size, args.fps)
     return 0

@@ -8,8 +8,9 @@ from .. import strictjson
 from ..config import DEFAULT_QUALITY, QUALITIES
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
-from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, add_sequence_options,
-                     load_presets, print_summary, run_result, simulate, start_backend)
+from .common import (CTRL_C_NOTICE, FIRST_STEP, PRESET_HELP, PROG, SET_HELP, Fmt,
+                     add_sequence_options, load_presets, print_summary, run_result, simulate,
+                     start_backend)
 
 
 RUN_EPILOG = """\
@@ -58,7 +59,7 @@ def _run(args) -> int:
             if not args.quiet:
                 nth = f" ({i + 1} of {len(resolved)})" if len(resolved) > 1 else ""
                 how = ("reusing the compiled simulator" if reused else
-                       "the first step compiles the kernels")
+                       "the first step compiles the kernels or loads them from the cache")
                 print(f"{PROG}: run {r.name}{nth}, quality {r.quality}, {r.dim}D, "
                       f"{scene.counts()['fluid']:,} fluid of {len(scene.pos):,} particles, arch "
                       f"{be.resolved}, {be.precision}; running to {r.t_end * 1e3:g} ms ({how})",
@@ -66,7 +67,7 @@ def _run(args) -> int:
             try:
                 run = simulate(sim, r.t_end, args.quiet, r.frame_times(), args.max_steps,
                                stop=stop,
-                               first_label="first step" + ("" if reused else " (compiling)"))
+                               first_label="first step" if reused else FIRST_STEP)
             except InstabilityError as e:
                 return _unstable(r, e, results, [x.name for x in resolved[i + 1:]],
                                  len(resolved) > 1, args)
@@ -95,7 +96,7 @@ def _run(args) -> int:
                 st = results[-1]["startup"]
                 print(f"  start-up    {st['seconds']:.2f} s (set-up {setup_s:.2f} s + first step "
                       f"{first:.2f} s); {st['session']}; {st['kernels_compiled']} kernels "
-                      "compiled")
+                      "compiled or loaded from the cache")
             if run["stopped_by"] == "ctrl-c":
                 left = [x.name for x in resolved[i + 1:]]
                 print(f"{PROG}: interrupted at t = {sim.stats.time * 1e3:.4g} ms (step "

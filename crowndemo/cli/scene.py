@@ -90,6 +90,15 @@ SCHEMA_RANGES = {"t_end": SCENE_KEYS["t_end"], "nu": LIQUID_KEYS["nu"],
                  "sigma": LIQUID_KEYS["sigma"]}
 
 
+UNITS = {**{k: "m" for k in SIZES}, "nu": "m^2/s", "sigma": "N/m"}
+
+
+def _sizes(val: Dict) -> str:
+    """'width 0.04 m, depth 0.08 m, nu 0.001 m^2/s': the options other than l0 and t_end."""
+    return ", ".join(f"{k} {v:g} {UNITS[k]}" if k in UNITS else f"{k} {v:g}"
+                     for k, v in val.items() if k not in ("l0", "t_end"))
+
+
 def _values(name: str, args, numerics: Numerics) -> Dict:
     """The scene's options with their defaults, checked (a ParameterError names the option)
     before Taichi starts or numpy allocates: positive sizes, sizes of at least l0, t_end, nu
@@ -243,7 +252,8 @@ def _scene(args) -> int:
     if not args.quiet:
         print(f"{PROG}: scene {name}, {args.dim}D, {len(scene.pos):,} particles, arch "
               f"{be.resolved}, {be.precision}; running to {t_end * 1e3:g} ms "
-              "(the first step compiles the kernels)", file=sys.stderr, flush=True)
+              "(the first step compiles the kernels or loads them from the cache)",
+              file=sys.stderr, flush=True)
     run = simulate(sim, t_end, args.quiet)
     obs = _observables(name, scene, sim)
     counts = sim.counts()
@@ -256,8 +266,7 @@ def _scene(args) -> int:
     if args.json:
         print(strictjson.dumps(result))
         return 0
-    size = ", ".join(f"{k} {v:g}" for k, v in val.items() if k not in ("l0", "t_end"))
-    head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {size}; gradient "
+    head = (f"scene {name}: {args.dim}D, l0 = {val['l0']:g} m, {_sizes(val)}; gradient "
             f"{args.gradient}; arch {be.resolved}, {be.precision}")
     print_summary(head, run, counts, scene.physics.c, setup_s, obs, dim=args.dim)
     return 0

@@ -111,7 +111,9 @@ def _names(args, table) -> list:
         names = [n for n in names if n not in ("crown-base-3m-drop", "verdicts")]
     unknown = [n for n in names if n not in table and n not in GROUPS]
     if unknown:
-        raise UsageError(f"unknown case {', '.join(unknown)}; allowed: "
+        from ..config.errors import did_you_mean
+        hint = did_you_mean(unknown[0], list(table) + list(GROUPS)) if len(unknown) == 1 else ""
+        raise UsageError(f"unknown case {', '.join(unknown)}{hint}; allowed: "
                          f"{', '.join(list(table) + list(GROUPS))} (see '{PROG} validate --list')")
     return names
 

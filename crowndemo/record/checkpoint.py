@@ -118,14 +118,27 @@ def _read(path: Path) -> Checkpoint:
 
 
 def differences(saved: dict, now: dict, prefix: str = "") -> List[str]:
-    """Keys whose values differ between two fingerprints, as 'key: saved -> now'."""
+    """Keys whose values differ between two fingerprints, as 'key: saved -> now'; a long
+    list is summarised ('frames: 21 every 0.1 ms to 2 ms -> 17 every 0.25 ms to 4 ms')."""
+    def short(v, ms: bool) -> str:
+        if not (isinstance(v, list) and len(v) > (1 if ms else 4) and
+                all(isinstance(x, (int, float)) for x in v)):
+            return repr(v)
+        f, u = (1e3, " ms") if ms else (1, "")
+        steps = [y - x for x, y in zip(v, v[1:])]
+        even = all(abs(d - steps[0]) <= 1e-9 * max(1.0, abs(steps[0])) for d in steps[:-1])
+        how = f"every {steps[0] * f:g}{u}" if even else f"from {v[0] * f:g}{u}"
+        return f"{len(v)} {how} to {v[-1] * f:g}{u}"
+
     out = []
     for k in sorted(set(saved) | set(now)):
         a, b = saved.get(k), now.get(k)
         if isinstance(a, dict) and isinstance(b, dict):
             out += differences(a, b, f"{prefix}{k}.")
         elif a != b:
-            out.append(f"{prefix}{k}: {a!r} -> {b!r}")
+            ms = k == "frame_times"
+            name = "frames" if ms else k
+            out.append(f"{prefix}{name}: {short(a, ms)} -> {short(b, ms)}")
     return out
 
 

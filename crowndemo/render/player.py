@@ -102,8 +102,11 @@ def open_recording(spec: str, root: str = DEFAULT_ROOT) -> Recording:
     path = spec if os.path.isdir(spec) and os.sep in spec.rstrip(os.sep) else \
         os.path.join(root, spec)
     if not os.path.isdir(path):
-        have = ", ".join(list_recordings(root)) or "none"
-        raise PlayError(f"no recording {spec!r} in {root}/ (recordings there: {have})")
+        from ..config.errors import did_you_mean
+        names = list_recordings(root)
+        have = ", ".join(names) or "none"
+        raise PlayError(f"no recording {spec!r} in {root}/{did_you_mean(spec, names)} "
+                        f"(recordings there: {have})")
     name = os.path.basename(os.path.normpath(path))
     meta = _read_metadata(path)
     complete = _is_complete(meta, path)
