@@ -20,7 +20,7 @@ def test_help(cmd, capsys):
     (["record", "quick-2d", "--then", "quick-2d"], "listed twice"),
     (["record", "quick-2d", "--resume", "--then", "quick"], "--resume takes one PRESET"),
     (["record", "quick-2d", "--checkpoint-every", "-1"], "--checkpoint-every"),
-    (["export", "quick-2d"], "--vtk"),
+    (["export", "quick-2dd"], "quick-2d"),                 # did you mean
     (["run", "quick-2d", "--playlist", "/nonexistent/list.txt"], "cannot read the playlist"),
     # an empty path would quietly mean the default folder
     (["record", "quick-2d", "--recordings", ""], "--recordings: an empty path"),

@@ -113,8 +113,6 @@ def fmt_counts(counts: Dict[str, int]) -> str:
     return ", ".join(parts) + f" ({sum(counts.values()):,} total)"
 
 
-
-
 FIRST_STEP = "first step (kernels compiled or loaded from the cache)"
 
 
