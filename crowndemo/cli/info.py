@@ -158,7 +158,8 @@ def _info_lattice(args) -> int:
     out = {"dim": d, "l0": physics.l0, "re_ratio": physics.re_ratio, "re": lat.re,
            "rho": physics.rho, "nu": physics.nu, "sigma": physics.sigma,
            "speed": physics.v_max, "sound_speed": physics.c,
-           "sound_speed_source": "given" if args.sound_speed is not None else f"{SOUND_SPEED_FACTOR:g} x speed",
+           "sound_speed_source": ("given" if args.sound_speed is not None
+                                  else f"{SOUND_SPEED_FACTOR:g} x speed"),
            "n0": lat.n0, "lambda0": lat.lambda0, "lambda0_over_l0_sq": lat.lambda0 / lat.l0 ** 2,
            "C": lat.C, "mass": lat.mass,
            "mass_unit": "kg" if d == 3 else "kg/m (per unit depth)",
@@ -394,13 +395,15 @@ def register(sub, common) -> None:
                    help="without PRESET: particle spacing [m], > 0 and <= 0.01")
     p.add_argument("--re-ratio", type=float, help="re / l0 (default: 2.1)")
     p.add_argument("--sigma", type=float,
-                   help=f"surface tension [N/m] (default: {WATER['sigma']:g}, water; 0 turns it off)")
+                   help=f"surface tension [N/m] (default: {WATER['sigma']:g}, water; 0 turns it "
+                        "off)")
     p.add_argument("--rho", type=float, help=f"density [kg/m^3] (default: {WATER['rho']:g})")
     p.add_argument("--nu", type=float,
                    help=f"kinematic viscosity [m^2/s] (default: {WATER['nu']:g}; 0 turns it off)")
     p.add_argument("--speed", type=float,
                    help="expected maximum speed v [m/s] for the Courant limit (default: 1)")
     p.add_argument("--sound-speed", type=float, default=None,
-                   help=f"artificial sound speed c [m/s] (default: {SOUND_SPEED_FACTOR:g} x speed, S8)")
+                   help=f"artificial sound speed c [m/s] (default: {SOUND_SPEED_FACTOR:g} x "
+                        "speed, S8)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=lambda a, argv: _info(a))

@@ -160,9 +160,10 @@ class Predictor:
     @ti.kernel
     def forces(self):
         """a* = nu <lap u> + g + (C/m) sum of minus the potential's gradient (S14, S22) at
-        r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone). With the relative Courant limit,
-        the largest |u_j - u_i| of the walk's pairs (module docstring): per particle into
-        scratch_float, then reduced per block and over the blocks."""
+        r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone). With the
+        relative Courant limit, the largest |u_j - u_i| of the walk's pairs (module
+        docstring): per particle into scratch_float, then reduced per block and over the
+        blocks."""
         if ti.static(self._walks):
             visc = self.coef.nu[None] * (2.0 * self.dim) / (
                 self.coef.lambda0[None] * self.coef.n0[None])

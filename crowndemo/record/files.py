@@ -6,7 +6,7 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import BinaryIO, Callable, Dict, Optional, Tuple, Union
+from typing import BinaryIO, Callable, Dict, List, Optional, Tuple, Union
 
 from .sinks import COMPLETE
 
@@ -43,7 +43,7 @@ def remove_rendered(folder: PathLike, keep_frames: bool = False) -> int:
     return len(gone)
 
 
-def rendered_frames(folder: PathLike) -> list:
+def rendered_frames(folder: PathLike) -> List[str]:
     """The rendered frames of the recording in ``folder``, in order (paths as strings)."""
     return sorted(str(p) for p in Path(folder, FRAMES).glob(FRAME_GLOB))
 

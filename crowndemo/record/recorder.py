@@ -227,5 +227,6 @@ def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resum
     return result
 
 
-__all__ = ["record_preset", "resume_point", "readable_metadata", "RecordResult", "RecordError", "AlreadyComplete",
+__all__ = ["record_preset", "resume_point", "readable_metadata", "RecordResult", "RecordError",
+           "AlreadyComplete",
            "fingerprint", "frame_times"]

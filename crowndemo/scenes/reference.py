@@ -12,14 +12,14 @@ from ..core.lattice import wall_layers
 from .base import Scene, assemble, container_walls, lattice_block, particle_faces
 
 
-
 def _walls_faces(dim: int) -> list:
     """Floor and side walls of an open-top container."""
     return ["x-", "x+", "y-"] if dim == 2 else ["x-", "x+", "y-", "y+", "z-"]
 
 
 def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, depth: float = 0.04,
-                     nu: float = WATER["nu"], t_end: float = 0.5, numerics: Optional[Numerics] = None,
+                     nu: float = WATER["nu"], t_end: float = 0.5,
+                     numerics: Optional[Numerics] = None,
                      **physics) -> Scene:
     """A column of water of height ``depth`` at rest in a container ``width`` wide (square
     floor in 3D); P(z) = rho g (H - z). v_max = sqrt(2 g H) sets c = 5 v_max (S8)."""
