@@ -2,7 +2,9 @@
 from ..core.lattice import wall_layers
 from .base import Scene, container_walls, lattice_block
 from .crown import crown, crown_base_radius
-from .reference import circularity, dam_break, equivalent_radius, hydrostatic_tank, square_patch
+from .reference import (circularity, dam_break, equivalent_radius, hydrostatic_tank,
+                        shear_amplitude, shear_wave, square_patch)
 
 __all__ = ["Scene", "circularity", "container_walls", "crown", "crown_base_radius", "dam_break",
-           "equivalent_radius", "hydrostatic_tank", "lattice_block", "square_patch", "wall_layers"]
+           "equivalent_radius", "hydrostatic_tank", "lattice_block", "shear_amplitude",
+           "shear_wave", "square_patch", "wall_layers"]

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..core import FLUID, Numerics, simulator_for
 from ..core.params import GRAVITY, WATER
-from ..scenes import dam_break, hydrostatic_tank
+from ..scenes import dam_break, hydrostatic_tank, shear_amplitude, shear_wave
 from ..scenes.crown import crown_base_radius
 from ..scenes.drop import oscillating_drop, resting_drop
 from . import oscillation
@@ -200,6 +200,31 @@ def _laplace(dim: int) -> Case:
                 lambda s: R / s, run, variants=("f64", "safety/2"))
 
 
+# ---- viscous decay of a shear wave --------------------------------------------------------
+def _shear_wave(dim: int) -> Case:
+    wavelength = 2.0e-3
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        scene = shear_wave(dim=dim, wavelength=wavelength, l0=l0, numerics=numerics)
+        sim = simulator_for(scene)
+        amplitude = []
+
+        def sample(s, i):
+            snap = s.snapshot()
+            amplitude.append(shear_amplitude(snap["pos"], snap["vel"], wavelength, l0))
+        sim.run(scene.t_end, frame_times=(0.0, scene.t_end), on_frame=sample)
+        ref = scene.info["decay_1_s"]
+        rate = (-math.log(amplitude[1] / amplitude[0]) / scene.t_end if amplitude[1] > 0
+                else math.inf)
+        return Outcome(rate, ref, abs(rate / ref - 1), sim)
+
+    return Case(f"shear-wave-{dim}d", dim, "decay rate of a free layer's shear wave [1/s]",
+                "nu k^2, exact Navier-Stokes solution (scenes/reference.py)", "lambda/l0",
+                (10, 20, 40) if dim == 2 else (10, 20, 30), (20,) if dim == 2 else (10,),
+                lambda s: wavelength / s, run,
+                variants=("f64", "safety/2", "gradient=sum", "gradient=seed"))   # no floor
+
+
 # ---- crown base radius -----------------------------------------------------------------------
 def crown_case(preset: str = "quick", t_end: Optional[float] = None,
                refine: Tuple[float, ...] = (1.0, 0.8, 0.6),
@@ -244,7 +269,7 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:
-    cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace)
+    cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace, _shear_wave)
              for d in (2, 3)]
     cases.append(crown_case("quick"))
     if full:
