@@ -91,8 +91,9 @@ def shear_wave(dim: int = 2, wavelength: float = 2.0e-3, l0: float = 1.0e-4,
     too, where the exact flow would need a shear traction; their disturbance decays as
     exp(-k |x - x_end|), so ``shear_amplitude`` measures within lambda of x = 0, at least
     lambda from either end, where it is down by exp(-2 pi) = 2e-3 (in 2D the measured rate
-    matches the lattice Laplacian's own prediction to 0.05 %: tests/test_viscous_flow.py). U sets c = 5 U (S8): the flow only
-    needs the pressure to hold the lattice. U = shift l0 / t_end: the fastest layers move
+    matches the lattice Laplacian's own prediction to 0.05 %: tests/test_viscous_flow.py).
+    U sets c = 5 U (S8): the flow only needs the pressure to hold the lattice.
+    U = shift l0 / t_end: the fastest layers move
     ``shift`` l0 in the run. Particles sheared past each other by a sizeable part of l0 are no
     longer on the lattice, and that disorder, not the viscosity model, then dominates the
     error (measured, 2D, lambda = 40 l0: -1.2 % at a 1.5 l0 shift against -0.1 % at 0.02 l0)."""
