@@ -1,6 +1,7 @@
 """Reference scenes with known answers (method.md §7), in 2D and 3D: hydrostatic tank,
-dam break (column a x 2a), a free square patch of liquid without gravity, and a free layer
-carrying a decaying shear wave (an exact solution of the Navier-Stokes equations)."""
+dam break (column a x 2a), a free square patch of liquid without gravity, and two exact
+viscous flows: a free layer carrying a decaying shear wave, and a layer sliding over a floor
+at rest (Stokes's first problem)."""
 from __future__ import annotations
 
 import math
@@ -9,8 +10,10 @@ from typing import Optional
 import numpy as np
 
 from ..core.params import GRAVITY, WATER, Numerics, Physics
+from ..core.state import FLUID
 from ..core.lattice import wall_layers
-from .base import Scene, assemble, container_walls, lattice_block, particle_faces
+from .base import (Scene, assemble, container_walls, floor_face, lattice_block,
+                   particle_faces)
 
 
 def _walls_faces(dim: int) -> list:
@@ -128,6 +131,57 @@ def shear_amplitude(pos: np.ndarray, vel: np.ndarray, wavelength: float, l0: flo
         mid &= np.abs(pos[:, 1]) < 2.0 * l0
     cz = np.cos(2.0 * math.pi / wavelength * pos[mid, -1])
     return float((vel[mid, 0] * cz).sum() / (cz * cz).sum())
+
+
+def sliding_layer(dim: int = 2, delta: float = 1.0e-3, l0: float = 1.0e-4,
+                  shift: float = 0.02, nu: float = WATER["nu"],
+                  numerics: Optional[Numerics] = None) -> Scene:
+    """A layer of liquid 4 delta deep on the floor z = 0, moving at U along x over the floor
+    at rest, without gravity or surface tension: Stokes's first problem seen from the moving
+    liquid, u = U erf(z / (2 sqrt(nu t))). The run ends when 2 sqrt(nu t) = ``delta``; the
+    liquid's momentum deficit per floor area is then 2 U sqrt(nu t / pi) = U delta /
+    sqrt(pi). The layer is 32 delta long (16 delta in 3D, and 20 l0 wide in y), the floor
+    10 l0 longer on either side; ``momentum_deficit`` measures the middle half, 8 delta (4
+    delta) from the free ends. The floor is its wall and dummy particles, or the analytic
+    plane floor (``wall_model: plane``). U = shift l0 / t_end, as in ``shear_wave``: the
+    liquid slides ``shift`` l0 over the floor in the run."""
+    t_end = (0.5 * delta) ** 2 / nu
+    amplitude = shift * l0 / t_end
+    depth = 4.0 * delta
+    length = (32.0 if dim == 2 else 16.0) * delta
+    across = [20.0 * l0] * (dim - 2)
+    lo = [-length / 2.0] + [-w / 2.0 for w in across] + [0.0]
+    hi = [length / 2.0] + [w / 2.0 for w in across] + [depth]
+    fluid = lattice_block(lo, hi, l0)
+    vel = np.zeros_like(fluid)
+    vel[:, 0] = amplitude
+    ph = Physics(dim=dim, l0=l0, v_max=amplitude, gravity=0.0,
+                 **{**WATER, "sigma": 0.0, "nu": nu})
+    numerics = numerics or Numerics()
+    layers = wall_layers(ph.re_ratio)
+    floor_lo = [lo[0] - 10.0 * l0] + lo[1:]
+    floor_hi = [hi[0] + 10.0 * l0] + hi[1:]
+    faces = particle_faces([floor_face(dim)], dim, numerics)
+    walls = container_walls(floor_lo, floor_hi, l0, layers, faces) if faces else None
+    margin = (layers + 2) * l0
+    domain = (tuple(x - margin for x in floor_lo),
+              tuple(x + margin for x in floor_hi[:-1]) + (2.0 * depth,))
+    info = {"scene": "sliding layer", "delta_m": delta, "speed_m_s": amplitude,
+            "depth_m": depth, "length_m": length,
+            "deficit_m2_s": amplitude * delta / math.sqrt(math.pi), "walls": faces}
+    return assemble("sliding-layer", ph, numerics, fluid, vel, walls, domain, t_end, info)
+
+
+def momentum_deficit(pos: np.ndarray, vel: np.ndarray, kind: np.ndarray, speed: float,
+                     length: float, depth: float, l0: float) -> float:
+    """The liquid's momentum deficit per floor area (divided by rho), sum (U - u_x) dz over a
+    column: the mean of U - u_x over the fluid particles of ``sliding_layer``'s middle half
+    (|x| < length / 4; in 3D within 2 l0 of y = 0, away from the y faces) times the depth."""
+    pos, vel = np.asarray(pos, float), np.asarray(vel, float)
+    mid = (kind == FLUID) & (np.abs(pos[:, 0]) < length / 4.0)
+    if pos.shape[1] == 3:
+        mid &= np.abs(pos[:, 1]) < 2.0 * l0
+    return float((speed - vel[mid, 0]).mean() * depth)
 
 
 def equivalent_radius(n_fluid: int, dim: int, l0: float) -> float:

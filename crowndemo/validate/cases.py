@@ -14,7 +14,8 @@ import numpy as np
 
 from ..core import FLUID, Numerics, simulator_for
 from ..core.params import GRAVITY, WATER
-from ..scenes import dam_break, hydrostatic_tank, shear_amplitude, shear_wave
+from ..scenes import (dam_break, hydrostatic_tank, momentum_deficit, shear_amplitude, shear_wave,
+                      sliding_layer)
 from ..scenes.crown import crown_base_radius
 from ..scenes.drop import oscillating_drop, resting_drop
 from . import oscillation
@@ -225,6 +226,27 @@ def _shear_wave(dim: int) -> Case:
                 variants=("f64", "safety/2", "gradient=sum", "gradient=seed"))   # no floor
 
 
+# ---- a layer sliding over a floor at rest (Stokes's first problem) ------------------------
+def _sliding_layer(dim: int) -> Case:
+    delta = 1.0e-3
+
+    def run(l0: float, numerics: Numerics) -> Outcome:
+        scene = sliding_layer(dim=dim, delta=delta, l0=l0, numerics=numerics)
+        sim = simulator_for(scene)
+        sim.run(scene.t_end)
+        snap, info = sim.snapshot(), scene.info
+        deficit = momentum_deficit(snap["pos"], snap["vel"], snap["kind"], info["speed_m_s"],
+                                   info["length_m"], info["depth_m"], l0)
+        ref = info["deficit_m2_s"]
+        return Outcome(deficit, ref, abs(deficit / ref - 1), sim)
+
+    return Case(f"sliding-layer-{dim}d", dim,
+                "momentum deficit / rho of a layer stopped by the floor [m^2/s]",
+                "U delta / sqrt(pi), Stokes's first problem (scenes/reference.py)", "delta/l0",
+                (5, 10, 20) if dim == 2 else (5, 7, 10), (10,) if dim == 2 else (5,),
+                lambda s: delta / s, run, variants=("f64", "plane-floor"))
+
+
 # ---- crown base radius -----------------------------------------------------------------------
 def crown_case(preset: str = "quick", t_end: Optional[float] = None,
                refine: Tuple[float, ...] = (1.0, 0.8, 0.6),
@@ -269,7 +291,8 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:
-    cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace, _shear_wave)
+    cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace, _shear_wave,
+                         _sliding_layer)
              for d in (2, 3)]
     cases.append(crown_case("quick"))
     if full:
