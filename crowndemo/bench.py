@@ -394,7 +394,7 @@ def text_table(results: Sequence[Dict]) -> str:
     return "\n".join(lines)
 
 
-# ---- the machine -----------------------------------------------------------------------------
+# ---- the machine (here for bench --record; validate and sweep --record use machine_line) ------
 def cpu_model() -> str:
     try:
         with open("/proc/cpuinfo") as f:
@@ -423,13 +423,23 @@ def gpu_name() -> Optional[str]:
     return ", ".join(names) if out.returncode == 0 and names else None
 
 
+def os_name() -> str:
+    return f"{platform.system()} {platform.release()}"
+
+
+def machine_line() -> str:
+    """The machine in one line, as validate and sweep --record report it: "CPU model, N cores,
+    OS release"."""
+    return f"{cpu_model()}, {os.cpu_count() or 1} cores, {os_name()}"
+
+
 def machine() -> Dict:
     import numpy
     import taichi as ti
 
     info = {"cpu": cpu_model(), "cores": os.cpu_count() or 1, "usable_cores": usable_cores(),
             "python": platform.python_version(), "taichi": ".".join(map(str, ti.__version__)),
-            "numpy": numpy.__version__, "os": f"{platform.system()} {platform.release()}"}
+            "numpy": numpy.__version__, "os": os_name()}
     gpu = gpu_name()
     if gpu:
         info["gpu"] = gpu

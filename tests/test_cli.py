@@ -18,6 +18,38 @@ def test_help_exits_0(cmd, capsys):
     assert "examples:" in out
 
 
+# every command with --quality, and its default (None: the command picks the rung itself)
+QUALITY_DEFAULT = {"run": "draft", "record": "draft", "live": "draft", "sweep": "draft",
+                   "validate": "draft", "bench": None, "export": None, "info": None}
+
+
+@pytest.mark.parametrize("cmd", sorted(QUALITY_DEFAULT))
+def test_quality_and_set_options(cmd):
+    """--quality and --set come from common.add_quality / add_sets: the rungs as choices, each
+    command's default, --set repeatable into args.sets (validate has no --set)."""
+    from crowndemo.cli import build_parser
+    from crowndemo.cli.common import UsageError
+    from crowndemo.config import QUALITIES
+
+    parser = build_parser()
+    argv = [cmd] + (["quick"] if cmd in ("run", "record", "export") else [])
+    assert parser.parse_args(argv).quality == QUALITY_DEFAULT[cmd]
+    sets = [] if cmd == "validate" else ["--set", "scene.speed=3", "--set", "numerics.courant="]
+    args = parser.parse_args(argv + ["--quality", QUALITIES[-1]] + sets)
+    assert args.quality == QUALITIES[-1]
+    if cmd != "validate":
+        assert args.sets == ["scene.speed=3", "numerics.courant="]
+        assert parser.parse_args(argv).sets == []
+    with pytest.raises(UsageError, match="--quality: invalid choice"):
+        parser.parse_args(argv + ["--quality", "best"])
+
+
+def test_exit_statuses_keep_their_values():
+    """README and the tests name them: 3 unstable, 130 Ctrl-C."""
+    from crowndemo.cli.common import EXIT_INTERRUPTED, EXIT_UNSTABLE
+    assert (EXIT_UNSTABLE, EXIT_INTERRUPTED) == (3, 130)
+
+
 def test_info_json_matches_lattice_and_limits(capsys):
     assert main(["info", "--dim", "3", "--l0", "1e-4", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)

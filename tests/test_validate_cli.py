@@ -102,6 +102,16 @@ def test_validate_json_is_strict(tmp_path, capsys, ran, fake_backend):
         assert data["cases"][1]["error"] == 0.01 and data["interrupted"] is False
 
 
+def test_validate_describes_the_machine_as_bench_does(tmp_path, ran, fake_backend):
+    """One description of the machine (bench.machine_line): "CPU, N cores, OS release"."""
+    from crowndemo import bench
+    assert main(["validate", "hydrostatic-2d", "--out", str(tmp_path)]) == 0
+    machine = _strict((tmp_path / "validation.json").read_text())["machine"]
+    assert machine == bench.machine_line()
+    assert machine.startswith(bench.cpu_model() + ", ") and " cores, " in machine
+    assert f"Machine: {machine};" in (tmp_path / "validation.md").read_text()
+
+
 def test_validate_replaces_the_cases_report_as_a_whole(tmp_path, capsys, monkeypatch, ran,
                                                         fake_backend):
     """An older plot that this run could not redraw is removed; the other runs' reports
@@ -155,6 +165,16 @@ def test_validate_help_names_every_variant_the_code_runs(capsys):
     assert {"plane-floor", "relative-courant", "untrimmed", "f64"} <= set(names)
     assert f"base settings only (no {', '.join(names)})" in text        # --no-variants
     assert ", ".join(names) in text.split("examples:")[1]               # the epilog
+
+
+def test_validate_help_names_the_case_families(capsys):
+    assert main(["validate", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    listed = text.split("Cases: ", 1)[1].split("; groups:", 1)[0]
+    families = {f.strip() for f in listed.replace(" (each -2d and -3d)", "").split(",")}
+    for name in cases.all_cases(full=True):      # every case, by its family or its own name
+        family = name[:-3] if name.endswith(("-2d", "-3d")) else name
+        assert family in families, name
 
 
 # ---- sweep --------------------------------------------------------------------------------------

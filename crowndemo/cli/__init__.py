@@ -21,8 +21,8 @@ from ..config import PresetError  # noqa: E402
 from ..core.health import InstabilityError  # noqa: E402
 from ..core.params import ParameterError  # noqa: E402
 from ..render.window import RenderError  # noqa: E402
-from .common import (PROG, Fmt, Parser, UsageError, backend_options, error,  # noqa: E402
-                     parameter_message)
+from .common import (EXIT_INTERRUPTED, EXIT_UNSTABLE, PROG, Fmt, Parser,  # noqa: E402
+                     UsageError, backend_options, error, parameter_message)
 
 # the command modules, in the order `crowndemo --help` lists them
 COMMANDS = ["presets", "info", "run", "record", "export", "play", "live", "scene", "validate",
@@ -73,10 +73,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return error(parameter_message(e))
     except InstabilityError as e:
         print(f"{PROG}: {e}", file=sys.stderr)
-        return 3
+        return EXIT_UNSTABLE
     except KeyboardInterrupt:
         print(f"{PROG}: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     except BrokenPipeError:
         # the reader of stdout went away (`crowndemo info ... | head`): no traceback, and
         # nothing more written to the closed pipe, exit flush included

@@ -9,8 +9,10 @@ from typing import Dict, Sequence
 from .. import strictjson
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
-from ..config.schema import QUALITIES
-from .common import PROG, Fmt, Progress, UsageError, repo_root, start_backend
+from .common import (PROG, Fmt, Progress, UsageError, add_quality, add_sets, repo_root,
+                     start_backend)
+
+PRESET_QUALITY = "booth"    # of --preset runs, without --quality
 
 
 BENCH_EPILOG = """\
@@ -166,7 +168,7 @@ def _bench_presets(args, argv: Sequence[str]) -> int:
     if args.max_steps is not None and args.max_steps < 2:
         raise ParameterError("max_steps", args.max_steps, "an integer >= 2 (the first step "
                              "is the warm-up, the rest are timed)", "command line")
-    quality = args.quality or "booth"
+    quality = args.quality or PRESET_QUALITY
     resolved = [config.load(spec, quality, args.sets) for spec in args.preset]
     start_backend(args)
     results = []
@@ -206,11 +208,9 @@ def register(sub, common) -> None:
                    help="skip the stage-by-stage timing (5 extra steps per run)")
     p.add_argument("--preset", nargs="+", metavar="PRESET",
                    help="run these presets to their end time instead of the tank block")
-    p.add_argument("--quality", choices=QUALITIES,
-                   help="quality rung of --preset (default: booth)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a value of --preset (as in crowndemo run); for the tank "
-                        "block, a numerics value (numerics.KEY=VALUE)")
+    add_quality(p, None, "quality rung of --preset", shown=PRESET_QUALITY)
+    add_sets(p, "override a value of --preset (as in crowndemo run); for the tank block, a "
+                "numerics value (numerics.KEY=VALUE)")
     p.add_argument("--max-steps", type=int, metavar="N",
                    help="stop each --preset run after N steps, at least 2: the first "
                         "compiles or loads the kernels from the cache, the rest are timed "

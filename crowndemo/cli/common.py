@@ -2,7 +2,8 @@
 preset loading, running a simulator with a progress line, and the run summary.
 
 User mistakes (bad flags, parameters out of range, an unavailable arch) print one line
-``crowndemo: error: ...`` on stderr and return 2; an unstable run prints the reason and returns 3.
+``crowndemo: error: ...`` on stderr and return 2; an unstable run prints the reason and returns
+EXIT_UNSTABLE (3); Ctrl-C returns EXIT_INTERRUPTED (130).
 """
 from __future__ import annotations
 
@@ -18,6 +19,9 @@ from ..core.params import Numerics, ParameterError
 from ..interrupt import StopRun, stop_if_asked
 
 PROG = "crowndemo"
+# exit statuses besides 0 and 2 (error() below), the same for every command
+EXIT_UNSTABLE = 3           # the run broke a health limit (InstabilityError): "unstable: ..."
+EXIT_INTERRUPTED = 130      # stopped by Ctrl-C (128 + SIGINT, as a shell reports it)
 PROGRESS_EVERY_S = 2.0
 NUMERICS = Numerics()       # the core's defaults, shown in --help
 
@@ -226,6 +230,25 @@ PRESET_HELP = "a preset name (see 'crowndemo presets') or a path to a preset YAM
 SET_HELP = ("override a preset value, KEY.PATH=VALUE with VALUE read as YAML, e.g. "
             "scene.speed=7, quality.draft.l0=4e-4, numerics.courant=0.1; repeatable; "
             "an empty VALUE restores the default")
+
+
+def add_quality(p, default: Optional[str], help: str = "quality rung",
+                shown: Optional[str] = None) -> None:
+    """--quality, one of the quality rungs. ``default`` None leaves the choice to the command
+    (it can tell whether the option was given); ``shown`` is then the rung the help names as
+    the default (else config.DEFAULT_QUALITY, what load_preset falls back to). ``help`` is
+    the text before "(default: ...)"."""
+    from ..config import DEFAULT_QUALITY, QUALITIES
+    if default is not None:
+        shown = default
+    p.add_argument("--quality", choices=QUALITIES, default=default,
+                   help=f"{help} (default: {shown or DEFAULT_QUALITY})")
+
+
+def add_sets(p, help: str = SET_HELP) -> None:
+    """--set KEY=VALUE, repeatable, into ``args.sets`` (a list, empty when none)."""
+    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
+                   help=help)
 
 
 def load_preset(spec: str, args, quality: Optional[str] = None):

@@ -5,9 +5,9 @@ import sys
 from pathlib import Path
 from typing import Optional
 
-from ..config import QUALITIES
-from .common import PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError, load_preset, \
-    path_argument, require_folder, start_backend
+from .common import (EXIT_INTERRUPTED, EXIT_UNSTABLE, PRESET_HELP, PROG, SET_HELP, Fmt,
+                     Progress, UsageError, add_quality, add_sets, load_preset, path_argument,
+                     require_folder, start_backend)
 from .record import _recordings_option
 
 EXPORT_EPILOG = """\
@@ -84,7 +84,7 @@ def _export(args) -> int:
                       f"; '{PROG} record {r.name} --resume --no-render', with the same "
                       "--quality, --set and --recordings, continues it")
             print(f"{PROG}: the recording ended {res.status}{resume}", file=sys.stderr)
-            code = 3 if res.status.startswith("unstable") else 130
+            code = EXIT_UNSTABLE if res.status.startswith("unstable") else EXIT_INTERRUPTED
         meta = _read_meta(folder / METADATA)
     elif args.quality is not None or args.sets:
         from ..record.checkpoint import differences
@@ -143,9 +143,7 @@ def register(sub, common) -> None:
     p.add_argument("--recordings", type=path_argument, metavar="DIR",
                    help="folder of the recordings (default: $CROWNDEMO_RECORDINGS, else "
                         "./recordings)")
-    p.add_argument("--quality", choices=QUALITIES, default=None,
-                   help="quality rung, when recording first (default: draft)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP + " (when recording first)")
+    add_quality(p, None, "quality rung, when recording first")
+    add_sets(p, SET_HELP + " (when recording first)")
     p.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
     p.set_defaults(func=lambda a, argv: _export(a))

@@ -8,12 +8,11 @@ import sys
 from typing import Dict
 
 from .. import strictjson
-from ..config import DEFAULT_QUALITY, QUALITIES
 from ..config.schema import LIQUID_KEYS, RUNG_KEYS, SCENE_KEYS, Field
 from ..core import timestep
 from ..core.health import starts_too_fast
 from ..core.params import SOUND_SPEED_FACTOR, WATER, ParameterError
-from .common import (PRESET_HELP, SET_HELP, Fmt, UsageError, load_preset)
+from .common import PRESET_HELP, Fmt, UsageError, add_quality, add_sets, load_preset
 
 
 INFO_EPILOG = """\
@@ -386,10 +385,8 @@ def register(sub, common) -> None:
                                    "time-step limit, with the one that binds.")
     p.add_argument("preset", nargs="?", metavar="PRESET",
                    help=PRESET_HELP + " (without it: --dim and --l0 describe a lattice)")
-    p.add_argument("--quality", choices=QUALITIES, default=None,
-                   help=f"quality rung of the preset (default: {DEFAULT_QUALITY})")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP)
+    add_quality(p, None, "quality rung of the preset")
+    add_sets(p)
     p.add_argument("--dim", type=int, metavar="D", help="without PRESET: dimension, 2 or 3")
     p.add_argument("--l0", type=float, metavar="M",
                    help="without PRESET: particle spacing [m], > 0 and <= 0.01")

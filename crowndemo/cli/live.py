@@ -1,7 +1,7 @@
 """``crowndemo live``: the interactive booth mode (sliders, a Drop button, a live run)."""
 from __future__ import annotations
 
-from .common import PROG, SET_HELP, Fmt, start_backend
+from .common import PROG, Fmt, add_quality, add_sets, start_backend
 
 LIVE_EPILOG = """\
 examples:
@@ -38,7 +38,6 @@ def _live(args, argv) -> int:
 
 
 def register(sub, common) -> None:
-    from ..config import QUALITIES
     from ..render.live_control import DEFAULT_PRESET, QUALITY
     from ..render.options import add_render_options
 
@@ -49,10 +48,8 @@ def register(sub, common) -> None:
                                    "simulation running live at draft quality.")
     p.add_argument("preset", nargs="?", default=DEFAULT_PRESET, metavar="PRESET",
                    help="the preset the sliders start from (default: %(default)s)")
-    p.add_argument("--quality", choices=QUALITIES, default=QUALITY,
-                   help="quality rung (default: %(default)s)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP)
+    add_quality(p, QUALITY)
+    add_sets(p)
     add_render_options(p, lang=False, recording=False)
     p.set_defaults(func=_live)
 

@@ -9,11 +9,12 @@ import sys
 from pathlib import Path
 from typing import List, Optional
 
-from ..config import DEFAULT_QUALITY, QUALITIES
+from ..config import DEFAULT_QUALITY
 from ..core.params import ParameterError
-from .common import (CTRL_C_NOTICE, PRESET_HELP, PROG, SET_HELP, Fmt, Progress, UsageError,
-                     add_sequence_options, load_presets, path_argument, print_summary,
-                     require_folder, start_backend)
+from .common import (CTRL_C_NOTICE, EXIT_INTERRUPTED, EXIT_UNSTABLE, PRESET_HELP, PROG, Fmt,
+                     Progress, UsageError, add_quality, add_sequence_options, add_sets,
+                     load_presets, path_argument, print_summary, require_folder,
+                     start_backend)
 
 RECORD_EPILOG = """\
 examples:
@@ -285,7 +286,7 @@ def _ending(r, res, folder: Path, args, left: List[str]) -> Optional[int]:
     if res.status.startswith("unstable"):
         print(f"{PROG}: {res.error}", file=sys.stderr)
         print(f"{PROG}: {kept}{not_recorded}", file=sys.stderr)
-        return 3
+        return EXIT_UNSTABLE
     if res.complete:
         return None
     t, k = res.sim.stats.time, res.sim.stats.steps
@@ -293,7 +294,7 @@ def _ending(r, res, folder: Path, args, left: List[str]) -> Optional[int]:
     print(f"{PROG}: interrupted ({res.log.stopped_by}) at t = {t * 1e3:.4g} ms, step {k:,}; "
           f"{kept}; to resume: {_resume_command(r, args)}" + (not_recorded if ctrl_c else ""),
           file=sys.stderr)
-    return 130 if ctrl_c else None
+    return EXIT_INTERRUPTED if ctrl_c else None
 
 
 def _add_render_timing(folder: Path, meta: dict, sink, res) -> dict:
@@ -324,10 +325,8 @@ def register(sub, common) -> None:
                                    "checkpoint and metadata.json into "
                                    "RECORDINGS/PRESET/; --resume continues after Ctrl-C.")
     p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
-    p.add_argument("--quality", choices=QUALITIES, default=DEFAULT_QUALITY,
-                   help="quality rung (default: %(default)s)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP)
+    add_quality(p, DEFAULT_QUALITY)
+    add_sets(p)
     add_sequence_options(p)
     p.add_argument("--resume", action="store_true",
                    help="continue from RECORDINGS/PRESET/checkpoint.npz with the same "

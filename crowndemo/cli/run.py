@@ -5,12 +5,12 @@ import sys
 import time
 
 from .. import strictjson
-from ..config import DEFAULT_QUALITY, QUALITIES
+from ..config import DEFAULT_QUALITY
 from ..core.health import InstabilityError
 from ..core.params import ParameterError
-from .common import (CTRL_C_NOTICE, FIRST_STEP, PRESET_HELP, PROG, SET_HELP, Fmt,
-                     add_sequence_options, load_presets, print_summary, run_result, simulate,
-                     start_backend)
+from .common import (CTRL_C_NOTICE, EXIT_INTERRUPTED, EXIT_UNSTABLE, FIRST_STEP, PRESET_HELP,
+                     PROG, Fmt, add_quality, add_sequence_options, add_sets, load_presets,
+                     print_summary, run_result, simulate, start_backend)
 
 
 RUN_EPILOG = """\
@@ -110,7 +110,7 @@ def _run(args) -> int:
         print(strictjson.dumps(results[0] if len(results) == 1 else results))
     elif len(results) > 1:
         print(f"{len(results)} runs in {time.perf_counter() - t_all:.2f} s")
-    return 130 if stop.requested else 0
+    return EXIT_INTERRUPTED if stop.requested else 0
 
 
 def _unstable(r, e, results: list, left: list, chain: bool, args) -> int:
@@ -125,7 +125,7 @@ def _unstable(r, e, results: list, left: list, chain: bool, args) -> int:
     print(f"{PROG}: {r.name + ': ' if chain else ''}{e}", file=sys.stderr)
     if left:
         print(f"{PROG}: not run: {', '.join(left)}", file=sys.stderr)
-    return 3
+    return EXIT_UNSTABLE
 
 
 def register(sub, common) -> None:
@@ -136,11 +136,9 @@ def register(sub, common) -> None:
                                    "summary: particles, steps, dt and the limits that bound "
                                    "it, health, wall time.")
     p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
-    p.add_argument("--quality", choices=QUALITIES, default=DEFAULT_QUALITY,
-                   help="quality rung: draft (minutes on a CPU), booth (l0 ~0.3 mm), seed "
-                        "(the seed's ~12M particles, a GPU) (default: %(default)s)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP)
+    add_quality(p, DEFAULT_QUALITY, "quality rung: draft (minutes on a CPU), booth (l0 ~0.3 "
+                                    "mm), seed (the seed's ~12M particles, a GPU)")
+    add_sets(p)
     add_sequence_options(p)
     p.add_argument("--max-steps", type=int, metavar="N",
                    help="stop each run after N steps (a smoke test)")

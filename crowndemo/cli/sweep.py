@@ -6,9 +6,9 @@ import re
 import shlex
 import sys
 
-from ..config import QUALITIES
-from .common import (PRESET_HELP, PROG, SET_HELP, Fmt, UsageError, load_preset, path_argument,
-                     repo_root, require_folder, start_backend)
+from .common import (EXIT_INTERRUPTED, PRESET_HELP, PROG, Fmt, UsageError, add_quality,
+                     add_sets, load_preset, path_argument, repo_root, require_folder,
+                     start_backend)
 
 # numbers like -1e-3 are values, not options (argparse alone knows only -1 and -0.5)
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
@@ -103,7 +103,7 @@ def _sweep(args, argv) -> int:
     print(table)
     print(f"{PROG}: wrote {out}/regime.md, regime.json"
           + (", regime.png" if why is None else f" (no image: {why})"), file=sys.stderr)
-    return 130 if interrupted else 0
+    return EXIT_INTERRUPTED if interrupted else 0
 
 
 def _write(out: str, base, points, planned: int, command: str, sets, interrupted: str):
@@ -135,7 +135,7 @@ def _record(base, table: str, out: str, has_image: bool, argv) -> None:
     import datetime
     import shutil
 
-    from .validate import _machine
+    from ..bench import machine_line
 
     docs = os.path.join(repo_root(), "docs")
     os.makedirs(docs, exist_ok=True)
@@ -143,7 +143,7 @@ def _record(base, table: str, out: str, has_image: bool, argv) -> None:
              f"{base.l0 * 1e3:g} mm), D = {base.scene['drop'] * 1e3:g} mm", "",
              "Written by `crowndemo sweep --record`; the verdicts follow the crown rule of "
              "the README's **validate** section.", "",
-             f"- machine: {_machine()}", f"- date: {datetime.date.today().isoformat()}",
+             f"- machine: {machine_line()}", f"- date: {datetime.date.today().isoformat()}",
              f"- command: `{' '.join([PROG] + [shlex.quote(a) for a in argv])}`", ""]
     if has_image:
         shutil.copyfile(os.path.join(out, "regime.png"), os.path.join(docs, "regime.png"))
@@ -166,10 +166,8 @@ def register(sub, common) -> None:
                    help="film thicknesses [m] (default: 0.5, 1 and 2 x the preset's)")
     p.add_argument("--speed", type=float, nargs="+", metavar="U",
                    help="impact speeds [m/s] (default: 2 4 6 8)")
-    p.add_argument("--quality", choices=QUALITIES, default="draft",
-                   help="quality rung (default: draft)")
-    p.add_argument("--set", dest="sets", action="append", default=[], metavar="KEY=VALUE",
-                   help=SET_HELP)
+    add_quality(p, "draft")
+    add_sets(p)
     p.add_argument("--out", type=path_argument, metavar="DIR",
                    help="folder for the map (default: reports/ at the repository root, "
                         "wherever the command runs)")

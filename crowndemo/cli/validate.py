@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import datetime
 import os
-import platform
 import shlex
 import sys
 
-from .common import (PROG, Fmt, UsageError, path_argument, repo_root, require_folder,
-                     start_backend)
+from .common import (EXIT_INTERRUPTED, PROG, Fmt, UsageError, add_quality, path_argument,
+                     repo_root, require_folder, start_backend)
 
 GROUPS = ("stability", "verdicts")
 INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
@@ -24,10 +23,10 @@ examples:
   crowndemo validate --list
   crowndemo validate --record                    # also rewrite VALIDATION.md
 
-Cases: hydrostatic, dam-break, drop-oscillation, laplace (each -2d and -3d), crown-base-quick,
-crown-base-3m-drop; groups: stability, verdicts. Each case runs at three resolutions in the
-base settings and, at the middle one, in its settings variants (--list says which case runs
-which):
+Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer (each
+-2d and -3d), crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. Each case runs
+at three resolutions in the base settings and, at the middle one, in its settings variants
+(--list says which case runs which):
   {variants}
 Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
 matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
@@ -61,19 +60,6 @@ class _VariantsFmt(Fmt):
     def _get_help_string(self, action):
         text = action.help or ""
         return text.replace("{variants}", variants_text()) if "{variants}" in text else text
-
-
-def _machine() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    cpu = line.split(":", 1)[1].strip()
-                    break
-    except OSError:
-        pass
-    return f"{cpu}, {os.cpu_count()} cores, {platform.system()} {platform.release()}"
 
 
 def _list(table, extra, as_json: bool = False) -> int:
@@ -172,6 +158,7 @@ def _write(out, header, rows, stab, verd, ran: dict) -> dict:
 
 
 def _validate(args, argv) -> int:
+    from ..bench import machine_line
     from ..validate import cases as cases_mod
     from ..validate import report, stability, verdicts
 
@@ -187,7 +174,7 @@ def _validate(args, argv) -> int:
         if not args.json:
             print(text, file=sys.stderr, flush=True)
 
-    result = {"machine": _machine(), "date": datetime.date.today().isoformat(),
+    result = {"machine": machine_line(), "date": datetime.date.today().isoformat(),
               "command": " ".join([PROG] + [shlex.quote(a) for a in argv]),
               "arch": be.resolved, "precision": be.precision, "quick": args.quick}
     found = {"cases": [], "stability": [], "verdicts": []}
@@ -227,7 +214,7 @@ def _validate(args, argv) -> int:
         for k, v in paths.items():
             print(f"{k}: {v}", file=sys.stderr)
     if interrupted:
-        return 130
+        return EXIT_INTERRUPTED
     return 1 if any(not r.passed for r in stab) else 0
 
 
@@ -264,7 +251,6 @@ def _record(result, rows, stab, verd, paths) -> None:
 
 
 def register(sub, common) -> None:
-    from ..config import QUALITIES
     p = sub.add_parser("validate", parents=common, formatter_class=_VariantsFmt,
                        epilog=VALIDATE_EPILOG,
                        help="error against run time for the reference cases; stability suite",
@@ -279,8 +265,7 @@ def register(sub, common) -> None:
                         "and no verdicts unless named")
     p.add_argument("--no-variants", action="store_true",
                    help="base settings only (no {variants})")
-    p.add_argument("--quality", choices=QUALITIES, default="draft",
-                   help="quality of the verdict runs (default: draft)")
+    add_quality(p, "draft", "quality of the verdict runs")
     p.add_argument("--out", type=path_argument, metavar="DIR", default=None,
                    help="folder for the reports (default: reports/ at the repository root)")
     p.add_argument("--record", action="store_true",
