@@ -9,10 +9,13 @@ the gradient form) selects the simulator.
 from __future__ import annotations
 
 import math
-from typing import Dict, List
+from typing import TYPE_CHECKING, Dict, List
 
 from .core.params import Model
 from .core.step import Simulator, max_particles
+
+if TYPE_CHECKING:
+    from .scenes.base import Scene
 
 HEADROOM = 1.25         # capacity of a reallocated simulator, times the scene's particles
 
@@ -35,7 +38,7 @@ class Session:
         self.reallocations = 0          # of them, those that replaced a too-small one
         self.events: List[str] = []     # what each load did, for summaries
 
-    def load(self, scene) -> Simulator:
+    def load(self, scene: Scene) -> Simulator:
         """A simulator for ``scene``'s model, configured with its values and loaded with it."""
         model = Model.of(scene.physics, scene.numerics)
         n = len(scene.pos)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from typing import Iterable, Optional
+from typing import Any, Iterable, Optional
 
 MISSING = object()          # the value of a key that was never given
 
@@ -33,7 +33,7 @@ class PresetError(ValueError):
         return text
 
 
-def format_value(value) -> str:
+def format_value(value: Any) -> str:
     """A value as it would be written in YAML (short), or ``(missing)``."""
     if value is MISSING:
         return "(missing)"

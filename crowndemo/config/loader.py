@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, Iterable, List, Optional, Tuple
 
 from .errors import PresetError, did_you_mean
 from .merge import DEFAULT_SOURCE, SET_SOURCE, Origin, deep_merge, origin_of
@@ -127,7 +127,7 @@ class Document:
         """The chain of preset files, base first, without the ``--set`` layer."""
         return [label for label in self.chain if label != SET_SOURCE]
 
-    def source_of(self, key_path) -> str:
+    def source_of(self, key_path: Iterable[str]) -> str:
         """The source that wrote a key (or the nearest enclosing one), else this file."""
         p = tuple(key_path)
         while p:
@@ -136,12 +136,12 @@ class Document:
             p = p[:-1]
         return self.label
 
-    def writer_of(self, key_path) -> str:
+    def writer_of(self, key_path: Iterable[str]) -> str:
         """The source that wrote exactly this key (a null or an empty ``--set`` counts: it
         restored the default), else DEFAULT_SOURCE: the value is the schema's default."""
         return self.origin.get(tuple(key_path), DEFAULT_SOURCE)
 
-    def missing_source(self, key_path) -> str:
+    def missing_source(self, key_path: Iterable[str]) -> str:
         """Whom to name for a required key that has no value: the file or ``--set KEY=``
         whose null removed it (or an enclosing mapping), else this file."""
         p = tuple(key_path)
@@ -152,7 +152,7 @@ class Document:
             p = p[:-1]
         return self.label
 
-    def rank_of(self, key_path) -> int:
+    def rank_of(self, key_path: Iterable[str]) -> int:
         return self.ranks.get(self.origin.get(tuple(key_path), ""), -1)
 
 

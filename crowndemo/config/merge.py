@@ -14,7 +14,7 @@ that wrote it (a file's label or ``--set``). Merging ``over`` onto ``base``:
 from __future__ import annotations
 
 import copy
-from typing import Dict, Tuple
+from typing import Any, Dict, Tuple
 
 Path = Tuple[str, ...]
 Origin = Dict[Path, str]
@@ -26,7 +26,7 @@ ALTERNATIVES = {("scene",): (("speed", "height"),)}
 ATOMIC = {("title",), ("description",)}
 
 
-def origin_of(data, label: str, path: Path = ()) -> Origin:
+def origin_of(data: Any, label: str, path: Path = ()) -> Origin:
     """Every key path of ``data`` (mappings and leaves) attributed to ``label``."""
     out: Origin = {}
     if isinstance(data, dict):
@@ -43,7 +43,8 @@ def _drop(origin: Origin, path: Path) -> None:
         del origin[p]
 
 
-def deep_merge(base: dict, base_origin: Origin, over: dict, over_origin: Origin):
+def deep_merge(base: dict, base_origin: Origin, over: dict,
+               over_origin: Origin) -> Tuple[dict, Origin]:
     """(data, origin) of ``over`` merged onto ``base``; neither input is changed."""
     data = copy.deepcopy(base)
     origin = dict(base_origin)

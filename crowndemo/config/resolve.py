@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional, Tuple
+from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
 
 from ..core import timestep
 from ..core.health import starts_too_fast
@@ -15,6 +15,9 @@ from .errors import MISSING, PresetError
 from .loader import Document
 from .merge import DEFAULT_SOURCE
 from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
+
+if TYPE_CHECKING:
+    from ..scenes.base import Scene
 
 SPEED_MAX = 50.0        # m/s: beyond this the explicit step is not meant to serve
 DT_FLOOR = 1.0e-8       # s: a time step below this is refused (billions of steps)
@@ -72,7 +75,7 @@ class Resolved:
                     sigma=self.liquid["sigma"], gravity=s["gravity"],
                     sound_speed=s.get("sound_speed"), re_ratio=s["re_ratio"])
 
-    def build_scene(self, l0: Optional[float] = None):
+    def build_scene(self, l0: Optional[float] = None) -> Scene:
         """The particles (numpy only); ``l0`` builds the same scene at another spacing."""
         from ..scenes import crown
         kw = self.crown_kwargs()

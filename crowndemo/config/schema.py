@@ -20,7 +20,7 @@ from __future__ import annotations
 import copy
 import math
 from dataclasses import dataclass
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, Iterable, Optional, Tuple
 
 from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, WALL_MODELS, WATER
 from .errors import MISSING, PresetError, did_you_mean
@@ -53,7 +53,7 @@ class Field:
     keys: Optional[Dict[str, "Field"]] = None
     allow_inf: bool = False
 
-    def in_range(self, v) -> bool:
+    def in_range(self, v: float) -> bool:
         """Whether the number ``v`` lies within lo and hi (each end as the field says)."""
         low = self.lo is not None and (v < self.lo or (v == self.lo and not self.lo_incl))
         high = self.hi is not None and (v > self.hi or (v == self.hi and not self.hi_incl))
@@ -86,7 +86,8 @@ class Field:
         return "a mapping with keys " + ", ".join(self.keys or ())
 
 
-def number(doc, unit="", lo=None, hi=None, lo_incl=False, hi_incl=True, **kw) -> Field:
+def number(doc: str, unit: str = "", lo: Optional[float] = None, hi: Optional[float] = None,
+           lo_incl: bool = False, hi_incl: bool = True, **kw: Any) -> Field:
     return Field("number", doc, unit, lo, lo_incl, hi, hi_incl, **kw)
 
 
@@ -183,7 +184,7 @@ TOP_KEYS = {
 TOP = Field("map", "a preset", keys=TOP_KEYS)
 
 
-def dotted(path) -> str:
+def dotted(path: Iterable[Any]) -> str:
     return ".".join(str(p) for p in path)
 
 

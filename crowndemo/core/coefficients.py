@@ -1,5 +1,7 @@
 """Run-time constants of the step, held in 0-D fields so that changing them never recompiles."""
 
+from typing import Sequence
+
 import taichi as ti
 
 from .lattice import LatticeConstants
@@ -22,7 +24,7 @@ class Coefficients:
         self.domain_hi = ti.Vector.field(dim, float, shape=())
 
     def set(self, physics: Physics, numerics: Numerics, lattice: LatticeConstants,
-            domain_lo, domain_hi) -> None:
+            domain_lo: Sequence[float], domain_hi: Sequence[float]) -> None:
         self.l0[None] = physics.l0
         self.re[None] = lattice.re
         self.re2[None] = lattice.re ** 2

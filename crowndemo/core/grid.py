@@ -13,6 +13,7 @@ grows: the walk stays exact, only more candidate pairs are visited.
 """
 
 import warnings
+from typing import Iterable
 
 import taichi as ti
 
@@ -28,7 +29,7 @@ warnings.filterwarnings("ignore", message="You are unrolling more than", categor
 FAR = 1.0e30       # |coordinate| beyond this (inf, NaN fails the test too) is not a bound
 
 
-def row_reach(off, k: int) -> int:
+def row_reach(off: Iterable[int], k: int) -> int:
     """How far along axis 0 the walk's row at cell offset ``off`` (axes 1..d-1) reaches, in
     cells of side h = re/k: the largest |o_0| such that the cell at (o_0, off) can hold a point
     within re of a point of the centre cell, sum_m (max(|o_m| - 1, 0) h)^2 < re^2; -1 when no

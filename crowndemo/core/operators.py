@@ -2,6 +2,8 @@
 Laplacian (S12). The pair functions here are the only place these formulas are written; the
 step's fused passes call them, and the stand-alone kernels below apply them to any field."""
 
+from typing import Any, Callable
+
 import taichi as ti
 
 from .coefficients import Coefficients
@@ -27,7 +29,7 @@ def laplacian_pair(dphi, w):
     return dphi * w
 
 
-def make_density_task(coef: Coefficients):
+def make_density_task(coef: Coefficients) -> Callable[..., Any]:
     """The neighbour task of the number density (S9): acc += w(r_ij), every kind counted."""
     @ti.func
     def task(i, j, rij, r2, acc: ti.template()):

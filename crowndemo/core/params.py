@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields, replace
-from typing import Optional
+from typing import Any, Optional, TypeVar
 
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
@@ -166,7 +166,10 @@ def _finite(x) -> bool:
     return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)
 
 
-def with_values(obj, **changes):
+_Params = TypeVar("_Params", Physics, Numerics)
+
+
+def with_values(obj: _Params, **changes: Any) -> _Params:
     """A copy of a Physics/Numerics with some values replaced (names checked)."""
     names = {f.name for f in fields(obj)}
     unknown = set(changes) - names

@@ -22,7 +22,7 @@ def _cpu_threads() -> int:
     return max(int(cfg.cpu_max_num_threads), 1) if cfg.arch in (ti.x64, ti.arm64) else 1
 
 
-def field_nbytes(f) -> int:
+def field_nbytes(f: ti.Field) -> int:
     """Bytes held by a Taichi field."""
     elem = 8 if f.dtype in (ti.f64, ti.i64) else 4
     comps = f.n * (f.m if hasattr(f, "m") else 1) if isinstance(f, ti.MatrixField) else 1

@@ -19,7 +19,7 @@ from typing import Dict, List
 import numpy as np
 
 from ..core.health import HealthReport
-from ..core.step import RunStats
+from ..core.step import RunStats, Simulator
 from .files import PathLike, atomic_write
 from .runlog import RunLog
 from .sinks import INTERRUPTED
@@ -152,7 +152,7 @@ class CheckpointSink:
         self.path, self.sim, self.log = Path(path), sim, log
         self.fingerprint, self.every, self.next_frame = fingerprint, every, next_frame
 
-    def frame(self, sim, index: int, time: float) -> None:
+    def frame(self, sim: Simulator, index: int, time: float) -> None:
         self.next_frame = index + 1
         if self.every and index % self.every == 0:
             self.save()

@@ -11,12 +11,18 @@ import json
 import platform
 from dataclasses import asdict
 from pathlib import Path
-from typing import Optional
+from typing import TYPE_CHECKING, Optional, Sequence
 
 from ..strictjson import finite_or_none
 from .files import CHECKPOINT, PathLike, atomic_write_json
 from .runlog import RunLog
 from .sinks import COMPLETE, RUNNING
+
+if TYPE_CHECKING:
+    from ..backend import Backend
+    from ..config.resolve import Resolved
+    from ..core.step import Simulator
+    from ..scenes.base import Scene
 
 FORMAT = 1
 
@@ -30,8 +36,9 @@ def versions() -> dict:
             "numpy": numpy.__version__, "python": platform.python_version()}
 
 
-def build(resolved, scene, sim, log: RunLog, status: str, frame_times, checkpoint_every: int,
-          backend=None, fingerprint: Optional[dict] = None,
+def build(resolved: Resolved, scene: Scene, sim: Simulator, log: RunLog, status: str,
+          frame_times: Sequence[float], checkpoint_every: int,
+          backend: Optional[Backend] = None, fingerprint: Optional[dict] = None,
           options: Optional[dict] = None) -> dict:
     """The metadata of a recording as a dict (JSON-ready). ``options``: how its files are
     made (rendering, snapshots), which a resumed run must keep (cli/record.py)."""
@@ -91,7 +98,7 @@ class MetadataSink:
         atomic_write_json(self.path, data)
         return data
 
-    def frame(self, sim, index: int, time: float) -> None:
+    def frame(self, sim: Simulator, index: int, time: float) -> None:
         self.write(RUNNING)
 
     def close(self, status: str) -> None:

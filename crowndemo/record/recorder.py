@@ -6,10 +6,10 @@ import json
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Callable, List, Optional, Sequence
+from typing import TYPE_CHECKING, Callable, List, Optional, Sequence
 
 from ..core.health import InstabilityError
-from ..interrupt import StopRun, stop_if_asked
+from ..interrupt import StopRequest, StopRun, stop_if_asked
 from ..strictjson import finite_or_none
 from . import checkpoint as ckpt
 from . import snapshots
@@ -18,6 +18,11 @@ from .metadata import MetadataSink
 from .metadata import read as read_metadata
 from .runlog import RunLog
 from .sinks import COMPLETE, INTERRUPTED, unstable
+
+if TYPE_CHECKING:
+    from ..backend import Backend
+    from ..config.resolve import Resolved
+    from ..control import Session
 
 
 class RecordError(ValueError):
@@ -54,12 +59,12 @@ class RecordResult:
         return self.status == COMPLETE
 
 
-def frame_times(resolved) -> List[float]:
+def frame_times(resolved: Resolved) -> List[float]:
     """The recorded frames: t = 0 and every frame interval to the end time."""
     return [0.0] + list(resolved.frame_times())
 
 
-def fingerprint(resolved, precision: str) -> dict:
+def fingerprint(resolved: Resolved, precision: str) -> dict:
     """What must not change between a checkpoint and its resumption (JSON-normal form)."""
     kw = resolved.crown_kwargs()
     kw["numerics"] = asdict(kw["numerics"])
@@ -87,7 +92,7 @@ def readable_metadata(folder: PathLike) -> dict:
         return {}
 
 
-def resume_point(resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint:
+def resume_point(resolved: Resolved, out_dir: PathLike, precision: str) -> ckpt.Checkpoint:
     """The checkpoint that ``--resume`` continues from, checked before anything runs or is
     written: AlreadyComplete when metadata.json says the recording is complete; RecordError
     when there is no checkpoint or either was made with other parameters."""
@@ -127,11 +132,13 @@ def _close(sinks: Sequence, status: str, result: RecordResult) -> str:
     return status
 
 
-def record_preset(resolved, out_dir: PathLike, sinks_extra: Sequence = (), resume: bool = False,
-                  *, session=None, checkpoint_every: int = 1, fluid_only: bool = True,
+def record_preset(resolved: Resolved, out_dir: PathLike, sinks_extra: Sequence = (),
+                  resume: bool = False, *, session: Optional[Session] = None,
+                  checkpoint_every: int = 1, fluid_only: bool = True,
                   max_steps: Optional[int] = None, on_step: Optional[Callable] = None,
-                  on_start: Optional[Callable] = None, stop=None,
-                  backend=None, resume_from: Optional[ckpt.Checkpoint] = None,
+                  on_start: Optional[Callable] = None, stop: Optional[StopRequest] = None,
+                  backend: Optional[Backend] = None,
+                  resume_from: Optional[ckpt.Checkpoint] = None,
                   options: Optional[dict] = None) -> RecordResult:
     """Record ``resolved`` (a config.Resolved) into ``out_dir``; returns how it ended.
 

@@ -7,12 +7,15 @@ checkpoint, metadata.json and a renderer are all sinks; the recorder calls them 
 """
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+if TYPE_CHECKING:
+    from ..core.step import Simulator
 
 
 @runtime_checkable
 class FrameSink(Protocol):
-    def frame(self, sim, index: int, time: float) -> None: ...
+    def frame(self, sim: Simulator, index: int, time: float) -> None: ...
 
     def close(self, status: str) -> None: ...
 

@@ -10,13 +10,16 @@ from __future__ import annotations
 import zipfile
 import zlib
 from pathlib import Path
-from typing import Dict
+from typing import TYPE_CHECKING, Dict
 
 import numpy as np
 
 from ..core.state import FLUID
 from .files import SNAPSHOTS, PathLike, atomic_write, frame_name
 from .runlog import RunLog
+
+if TYPE_CHECKING:
+    from ..core.step import Simulator
 
 FIELDS = ("pos", "vel", "pressure", "number_density", "kind", "id")
 SCALARS = ("time", "index")
@@ -36,7 +39,7 @@ class SnapshotSink:
         self.folder = self.recording / SNAPSHOTS
         self.log, self.fluid_only = log, fluid_only
 
-    def frame(self, sim, index: int, time: float) -> None:
+    def frame(self, sim: Simulator, index: int, time: float) -> None:
         sim.refresh_pressure()              # P and n at the frame's positions (output only)
         path = self.folder / frame_name(index)
         write(path, sim.snapshot(), index, time, self.fluid_only)
@@ -54,7 +57,7 @@ def write(path: PathLike, snap: Dict[str, np.ndarray], index: int, time: float,
         f, time=np.float64(time), index=np.int64(index), **arrays))
 
 
-def open_npz(path: PathLike):
+def open_npz(path: PathLike) -> np.lib.npyio.NpzFile:
     """``np.load`` of an .npz archive; ValueError, short, when the file is none (truncated,
     or overwritten by something else), where numpy would talk of pickles."""
     with open(path, "rb") as f:

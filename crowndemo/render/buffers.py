@@ -5,7 +5,7 @@ lies in the plane y = 0), colours from the chosen field."""
 
 import taichi as ti
 
-from ..core.state import FLUID
+from ..core.state import FLUID, ParticleState
 from .colours import COLOUR_MAP, MILK_HIGH, MILK_LOW, MODE_CODE, ColourScale
 
 SPEED, HEIGHT, PRESSURE, MILK = (MODE_CODE[m] for m in ("speed", "height", "pressure", "milk"))
@@ -21,7 +21,7 @@ class ParticleBuffers:
         self.cmap = ti.Vector.field(3, ti.f32, len(COLOUR_MAP))
         self.cmap.from_numpy(COLOUR_MAP)
 
-    def fill(self, state, scale: ColourScale) -> int:
+    def fill(self, state: ParticleState, scale: ColourScale) -> int:
         """Copy the fluid particles of ``state`` (a ParticleState); returns how many."""
         if state.capacity > self.capacity:
             raise ValueError(f"state capacity {state.capacity} exceeds the buffers' "

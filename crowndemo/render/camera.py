@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Tuple
+from typing import TYPE_CHECKING, Sequence, Tuple
 
 import numpy as np
 
 from ..scenes.crown import crown_base_radius
+
+if TYPE_CHECKING:
+    from ..config.resolve import Resolved
 
 Vec3 = Tuple[float, float, float]
 MARGIN = 0.85            # the framed box fills at most this fraction of the half-image
@@ -33,7 +36,7 @@ class Geometry:
     l0: float
 
     @classmethod
-    def from_resolved(cls, resolved) -> "Geometry":
+    def from_resolved(cls, resolved: Resolved) -> "Geometry":
         s = resolved.scene
         return cls(resolved.dim, s["drop"], s["film"], s["floor"], s["gap"], s["speed"],
                    s["t_end"], resolved.l0)
@@ -145,7 +148,8 @@ def project(pose: Pose, points: np.ndarray, resolution: Tuple[int, int]) -> np.n
     return np.c_[(ndc_x + 1) * w / 2, (1 - ndc_y) * h / 2, depth]
 
 
-def pixel_radius(pose: Pose, point, radius: float, resolution: Tuple[int, int]) -> float:
+def pixel_radius(pose: Pose, point: Sequence[float], radius: float,
+                 resolution: Tuple[int, int]) -> float:
     """The on-screen radius (pixels) of a sphere of ``radius`` at ``point``."""
     depth = project(pose, point, resolution)[0, 2]
     return radius / math.tan(math.radians(pose.fov) / 2) / depth * resolution[1] / 2

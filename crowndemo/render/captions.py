@@ -12,10 +12,13 @@ import os
 import sys
 import textwrap
 from dataclasses import dataclass
-from typing import Dict, List, Optional, Tuple
+from typing import TYPE_CHECKING, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
+
+if TYPE_CHECKING:
+    from ..config.resolve import Resolved
 
 LANGS = ("en", "ja")
 LATIN_FONTS = ("/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
@@ -76,7 +79,7 @@ def font(lang: str, size: int) -> ImageFont.FreeTypeFont:
     return ImageFont.load_default(size=size)       # Pillow's own scalable font
 
 
-def text_in(texts, lang: str) -> str:
+def text_in(texts: Union[str, Dict[str, str], None], lang: str) -> str:
     """A text given as one string or {en: ..., ja: ...}, in ``lang`` (else English)."""
     if isinstance(texts, dict):
         return texts.get(lang) or texts.get("en") or next(iter(texts.values()), "")
@@ -91,7 +94,7 @@ class CaptionInfo:
     gravity: float                  # m/s^2
 
     @classmethod
-    def from_resolved(cls, resolved) -> "CaptionInfo":
+    def from_resolved(cls, resolved: Resolved) -> "CaptionInfo":
         return cls(dict(resolved.title) if isinstance(resolved.title, dict)
                    else {"en": str(resolved.title)}, resolved.speed,
                    resolved.scene["gravity"])
@@ -157,7 +160,8 @@ def mark(image: np.ndarray, text: str, lang: str = "en") -> np.ndarray:
     return np.asarray(Image.alpha_composite(img, overlay).convert("RGB"))
 
 
-def title_card(size: Tuple[int, int], title, description, lang: str = "en",
+def title_card(size: Tuple[int, int], title: Union[str, Dict[str, str], None],
+               description: Union[str, Dict[str, str], None], lang: str = "en",
                marker: Optional[str] = None) -> np.ndarray:
     """A card (h, w, 3 uint8): the title large, the description wrapped beneath it."""
     lang = effective_lang(lang)

@@ -26,7 +26,7 @@ class FloorMesh:
         self.normals.from_numpy(np.tile(np.float32([0, 0, 1]), (4, 1)))
         self.indices.from_numpy(np.array([0, 1, 2, 0, 2, 3], dtype=np.int32))
 
-    def draw(self, scene) -> None:
+    def draw(self, scene: ti.ui.Scene) -> None:
         scene.mesh(self.vertices, self.indices, self.normals, color=self.colour,
                    two_sided=True)
 

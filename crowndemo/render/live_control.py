@@ -43,7 +43,7 @@ def session_starter() -> Callable:
     return lambda resolved: session.load(resolved.build_scene())
 
 
-def preset_height(base) -> float:
+def preset_height(base: config.Resolved) -> float:
     """The fall height of a resolved preset: its scene.height, else U^2 / (2 g) (inf
     without gravity, which live mode refuses)."""
     s, g = base.scene, base.scene["gravity"]
@@ -57,7 +57,7 @@ def unstable_advice(e: InstabilityError) -> str:
             "drop or a lower fall height")
 
 
-def sliders_for(base) -> Tuple[Slider, ...]:
+def sliders_for(base: config.Resolved) -> Tuple[Slider, ...]:
     """The sliders' ranges for a resolved base preset: film and drop at least 3 particle
     spacings across (what the config layer demands), the drop narrower than half the floor."""
     s, l0 = base.scene, base.l0
@@ -116,7 +116,7 @@ class LiveController:
         self.values[name] = slider.clamp(value)
         return self.values[name]
 
-    def resolve(self):
+    def resolve(self) -> config.Resolved:
         """The preset with the slider values, validated (PresetError on a mistake)."""
         return config.load(self.preset, self.quality,
                            self.sets + overrides(self.values, self.sliders))

@@ -6,12 +6,16 @@ from __future__ import annotations
 import argparse
 import math
 import os
-from typing import Callable, Tuple
+from typing import TYPE_CHECKING, Callable, Optional, Tuple
 
 from .captions import LANGS
 from .colours import DEFAULT_MODE, MODES
 from .renderer import BOOTH_RESOLUTION, DEFAULT_RESOLUTION
 from .view import RenderSettings
+
+if TYPE_CHECKING:
+    from ..config.resolve import Resolved
+    from .sink import FrameSink
 
 ORBIT_DEFAULT = 1.0          # degrees per frame when --orbit is given without a value
 
@@ -86,14 +90,15 @@ def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
                        help="render nothing (no frames, no video; needs no Vulkan)")
 
 
-def settings_from_args(args) -> RenderSettings:
+def settings_from_args(args: argparse.Namespace) -> RenderSettings:
     fps = getattr(args, "fps", RenderSettings.fps)
     return RenderSettings(colour=args.colour, lang=getattr(args, "lang", "en") or "en",
                           resolution=tuple(args.resolution), orbit=args.orbit,
                           video=getattr(args, "video", True), fps=fps)
 
 
-def sink_from_args(args, resolved, out_dir: str, resume: bool = False):
+def sink_from_args(args: argparse.Namespace, resolved: Resolved, out_dir: str,
+                   resume: bool = False) -> Optional[FrameSink]:
     """The FrameSink for a recording of ``resolved`` into ``out_dir`` (frames in
     ``out_dir/frames``), or None with --no-render. Checks Vulkan first: a RenderError (with how
     to install a driver) comes before any simulation time is spent."""

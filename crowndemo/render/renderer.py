@@ -7,6 +7,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
+from ..core.state import ParticleState
 from .buffers import ParticleBuffers
 from .camera import Pose
 from .colours import ColourScale
@@ -41,7 +42,7 @@ class Renderer:
             self.buffers = ParticleBuffers(capacity)
         return self.buffers
 
-    def draw(self, state, pose: Pose, scale: ColourScale, radius: float,
+    def draw(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
              floor: Optional[FloorMesh] = None) -> None:
         """Submit one frame: the fluid of ``state`` as spheres of world ``radius``."""
         cam, scene = self.camera, self.scene
@@ -76,7 +77,7 @@ class Renderer:
         rgb = np.transpose(img[:, ::-1, :3], (1, 0, 2))
         return (np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
-    def render(self, state, pose: Pose, scale: ColourScale, radius: float,
+    def render(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
                floor: Optional[FloorMesh] = None) -> np.ndarray:
         self.draw(state, pose, scale, radius, floor)
         return self.capture()

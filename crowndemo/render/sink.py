@@ -11,12 +11,16 @@ from __future__ import annotations
 
 import os
 import time as _time
-from typing import Dict, List, Optional
+from typing import TYPE_CHECKING, Dict, List, Optional
 
 from ..record.files import FRAMES, frame_name, remove_rendered, rendered_frames, video_names
 from . import video
 from .renderer import Renderer
 from .view import PresetView
+
+if TYPE_CHECKING:
+    from ..core.step import Simulator
+
 
 class FrameSink:
     def __init__(self, out_dir: str, view: PresetView, renderer: Optional[Renderer] = None,
@@ -48,7 +52,7 @@ class FrameSink:
     def render_seconds(self) -> float:
         return sum(self.frame_seconds)
 
-    def frame(self, sim, index: int, time: float) -> None:
+    def frame(self, sim: Simulator, index: int, time: float) -> None:
         """Render ``sim``'s particles at simulated ``time`` as frame ``index``."""
         if self.status is not None:
             raise RuntimeError("the frame sink is closed")

@@ -4,7 +4,7 @@ captioned frame of a particle state."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Tuple
 
 import numpy as np
 
@@ -12,6 +12,12 @@ from . import camera
 from .captions import CaptionInfo, draw_caption
 from .colours import DEFAULT_MODE, ColourScale
 from .renderer import DEFAULT_RESOLUTION
+
+if TYPE_CHECKING:
+    from ..config.resolve import Resolved
+    from ..core.state import ParticleState
+    from .floor import FloorMesh
+    from .renderer import Renderer
 
 SPHERE = 0.5        # drawn sphere radius / l0: neighbouring particles touch
 
@@ -39,7 +45,7 @@ class PresetView:
         self._floor = None
 
     @classmethod
-    def from_resolved(cls, resolved, settings: RenderSettings = RenderSettings()
+    def from_resolved(cls, resolved: Resolved, settings: RenderSettings = RenderSettings()
                       ) -> "PresetView":
         geometry = camera.Geometry.from_resolved(resolved)
         scale = ColourScale.for_scene(settings.colour, resolved.speed, geometry.film,
@@ -54,13 +60,13 @@ class PresetView:
         return self.start.orbited(self.settings.orbit * index)
 
     @property
-    def floor(self):
+    def floor(self) -> FloorMesh:
         if self._floor is None:                     # Taichi fields: made on first use
             from .floor import FloorMesh
             self._floor = FloorMesh(self.geometry)
         return self._floor
 
-    def image(self, renderer, state, time: float, index: int = 0,
+    def image(self, renderer: Renderer, state: ParticleState, time: float, index: int = 0,
               pose: Optional[camera.Pose] = None) -> np.ndarray:
         """One captioned frame (h, w, 3 uint8) of ``state`` at simulated ``time``."""
         img = renderer.render(state, pose or self.pose(index), self.scale, self.radius,

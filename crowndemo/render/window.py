@@ -22,7 +22,10 @@ import glob
 import os
 import socket
 import sys
-from typing import List, Optional, Tuple, Union
+from typing import TYPE_CHECKING, List, Optional, Tuple, Union
+
+if TYPE_CHECKING:
+    import taichi as ti
 
 INSTALL_HINT = ("install a Vulkan driver: on Debian/Ubuntu 'apt-get install "
                 "mesa-vulkan-drivers' (lavapipe, a software driver that needs no GPU), or "
@@ -49,7 +52,7 @@ def _ensure_backend() -> None:
 
 
 def open_window(title: str, resolution: Tuple[int, int], show: bool = False,
-                position: Tuple[int, int] = (100, 100)):
+                position: Tuple[int, int] = (100, 100)) -> ti.ui.Window:
     """A GGUI window (offscreen unless ``show``); RenderError when Vulkan is unavailable."""
     import taichi as ti
     global _ini_existed
@@ -71,7 +74,7 @@ def open_window(title: str, resolution: Tuple[int, int], show: bool = False,
     return window
 
 
-def close_window(window) -> None:
+def close_window(window: ti.ui.Window) -> None:
     """Destroy a window opened by ``open_window`` (safe to call twice)."""
     if window in _open:
         _open.remove(window)

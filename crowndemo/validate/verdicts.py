@@ -12,7 +12,7 @@ from dataclasses import asdict, dataclass
 from typing import Callable, Iterable, List, Optional, Tuple
 
 from .. import config
-from ..core import FLUID, InstabilityError, simulator_for
+from ..core import FLUID, InstabilityError, Simulator, simulator_for
 from .crown_metrics import CrownMetrics, film_edge, measure
 
 # preset -> what the seed saw
@@ -89,7 +89,7 @@ def film_limit(scene_info: Optional[dict], l0: float) -> Optional[float]:
     return None
 
 
-def run_and_observe(sim, resolved, scene_info: Optional[dict] = None,
+def run_and_observe(sim: Simulator, resolved: config.Resolved, scene_info: Optional[dict] = None,
                     times: Optional[List[float]] = None) -> Tuple[List[CrownMetrics], str]:
     """Run to the preset's end time (or until it goes unstable), measuring the crown at each
     of ``times`` reached (default ``observation_times``), and at the last time when it
@@ -112,8 +112,8 @@ def run_and_observe(sim, resolved, scene_info: Optional[dict] = None,
     return seen, outcome
 
 
-def run_and_measure(sim, resolved, scene_info: Optional[dict] = None
-                    ) -> Tuple[CrownMetrics, str]:
+def run_and_measure(sim: Simulator, resolved: config.Resolved,
+                    scene_info: Optional[dict] = None) -> Tuple[CrownMetrics, str]:
     """``run_and_observe`` with one look, at the last time reached; returns those metrics and
     the outcome."""
     seen, outcome = run_and_observe(sim, resolved, scene_info, times=[resolved.t_end])
