@@ -14,14 +14,14 @@ second order in k l0.
 import itertools
 import math
 
-import pytest
-
 import numpy as np
+import pytest
 
 from crowndemo.core import FLUID, Numerics, simulator_for
 from crowndemo.core.lattice import n0_lambda0
 from crowndemo.core.params import with_values
-from crowndemo.scenes import momentum_deficit, shear_amplitude, shear_wave, sliding_layer
+from crowndemo.scenes import (layer_middle, momentum_deficit, shear_amplitude, shear_wave,
+                              sliding_layer)
 
 L0 = 1.0e-4
 RE_RATIO = 2.1
@@ -48,7 +48,8 @@ def decay_rate(dim: int, waves: float) -> tuple:
     scene = shear_wave(dim=dim, wavelength=waves * L0, l0=L0)
     sim = simulator_for(scene)
     lam = scene.info["wavelength_m"]
-    a0 = shear_amplitude(sim.snapshot()["pos"], sim.snapshot()["vel"], lam, L0)
+    snap = sim.snapshot()
+    a0 = shear_amplitude(snap["pos"], snap["vel"], lam, L0)
     sim.run(scene.t_end)
     snap = sim.snapshot()
     a1 = shear_amplitude(snap["pos"], snap["vel"], lam, L0)
@@ -104,7 +105,7 @@ def test_sliding_layer_follows_stokes_with_the_no_slip_plane_at_the_wall_layer(w
     snap, info = sim.snapshot(), scene.info
     U = info["speed_m_s"]
     p, v = snap["pos"].astype(float), snap["vel"].astype(float)
-    mid = (snap["kind"] == FLUID) & (np.abs(p[:, 0]) < info["length_m"] / 4)
+    mid = (snap["kind"] == FLUID) & layer_middle(p, info["length_m"] / 4, l0)
     row = np.floor(p[mid, -1] / l0).astype(int)
     for r in range(20):                                    # z = 0.5 .. 19.5 l0: to 2 delta
         u = v[mid][row == r, 0].mean() / U

@@ -96,13 +96,14 @@ def shear_wave(dim: int = 2, wavelength: float = 2.0e-3, l0: float = 1.0e-4,
     lambda from either end, where it is down by exp(-2 pi) = 2e-3 (in 2D the measured rate
     matches the lattice Laplacian's own prediction to 0.05 %: tests/test_viscous_flow.py).
     U sets c = 5 U (S8): the flow only needs the pressure to hold the lattice.
-    U = shift l0 / t_end: the fastest layers move
-    ``shift`` l0 in the run. Particles sheared past each other by a sizeable part of l0 are no
-    longer on the lattice, and that disorder, not the viscosity model, then dominates the
-    error (measured, 2D, lambda = 40 l0: -1.2 % at a 1.5 l0 shift against -0.1 % at 0.02 l0)."""
+    U = shift l0 / t_end: the fastest layers move ``shift`` l0 in the run. Particles sheared
+    past each other by a sizeable part of l0 are no longer on the lattice, and that disorder,
+    not the viscosity model, then dominates the error (measured, 2D, lambda = 40 l0: -1.2 %
+    at a 1.5 l0 shift against -0.1 % at 0.02 l0)."""
     k = 2.0 * math.pi / wavelength
     rate = nu * k * k
-    amplitude = shift * l0 * rate / efolds
+    t_end = efolds / rate
+    amplitude = shift * l0 / t_end
     across = [wavelength + 10.0 * l0] * (dim - 2)
     lo = [-2.0 * wavelength] + [-w / 2.0 for w in across] + [0.0]
     hi = [2.0 * wavelength] + [w / 2.0 for w in across] + [wavelength]
@@ -116,7 +117,17 @@ def shear_wave(dim: int = 2, wavelength: float = 2.0e-3, l0: float = 1.0e-4,
     info = {"scene": "shear wave", "wavelength_m": wavelength, "amplitude_m_s": amplitude,
             "k_1_m": k, "decay_1_s": rate, "walls": []}
     return assemble("shear-wave", ph, numerics or Numerics(), fluid, vel, None, domain,
-                    efolds / rate, info)
+                    t_end, info)
+
+
+def layer_middle(pos: np.ndarray, half_length: float, l0: float) -> np.ndarray:
+    """Mask of the particles of a layer (``shear_wave``, ``sliding_layer``) that the exact
+    flow describes: |x| < ``half_length``, away from the layer's free x ends, and in 3D
+    within 2 l0 of its mid-plane y = 0, away from its y faces (``shear_amplitude``)."""
+    mid = np.abs(pos[:, 0]) < half_length
+    if pos.shape[1] == 3:
+        mid &= np.abs(pos[:, 1]) < 2.0 * l0
+    return mid
 
 
 def shear_amplitude(pos: np.ndarray, vel: np.ndarray, wavelength: float, l0: float) -> float:
@@ -126,9 +137,7 @@ def shear_amplitude(pos: np.ndarray, vel: np.ndarray, wavelength: float, l0: flo
     Measured at lambda = 20 l0: the mid-plane's error -5.9 %, -0.73 %, -0.24 %, -0.24 % for a
     layer 6, 12, 20, 30 l0 wide; the 2D layer, which has no y faces, -0.35 %)."""
     pos, vel = np.asarray(pos, float), np.asarray(vel, float)
-    mid = np.abs(pos[:, 0]) < wavelength
-    if pos.shape[1] == 3:
-        mid &= np.abs(pos[:, 1]) < 2.0 * l0
+    mid = layer_middle(pos, wavelength, l0)
     cz = np.cos(2.0 * math.pi / wavelength * pos[mid, -1])
     return float((vel[mid, 0] * cz).sum() / (cz * cz).sum())
 
@@ -178,9 +187,7 @@ def momentum_deficit(pos: np.ndarray, vel: np.ndarray, kind: np.ndarray, speed: 
     column: the mean of U - u_x over the fluid particles of ``sliding_layer``'s middle half
     (|x| < length / 4; in 3D within 2 l0 of y = 0, away from the y faces) times the depth."""
     pos, vel = np.asarray(pos, float), np.asarray(vel, float)
-    mid = (kind == FLUID) & (np.abs(pos[:, 0]) < length / 4.0)
-    if pos.shape[1] == 3:
-        mid &= np.abs(pos[:, 1]) < 2.0 * l0
+    mid = (kind == FLUID) & layer_middle(pos, length / 4.0, l0)
     return float((speed - vel[mid, 0]).mean() * depth)
 
 
