@@ -53,7 +53,7 @@ def test_the_bench_says_how_it_compiled(capsys, monkeypatch):
 
 
 def test_the_bench_says_where_the_neighbour_list_is_not_stored_as_by_default():
-    from crowndemo.bench import _build
+    from crowndemo.bench.tables import _build
     run = {"precision": "f32", "single_thread": False, "fast_compile": False}
     assert _build({**run, "list_layout": "particle"}) == "f32"
     assert _build({**run, "list_layout": None}) == "f32"          # no list

@@ -103,12 +103,12 @@ def test_validate_json_is_strict(tmp_path, capsys, ran, fake_backend):
 
 
 def test_validate_describes_the_machine_as_bench_does(tmp_path, ran, fake_backend):
-    """One description of the machine (bench.machine_line): "CPU, N cores, OS release"."""
-    from crowndemo import bench
+    """One description of the machine (machine.machine_line): "CPU, N cores, OS release"."""
+    from crowndemo import machine as host
     assert main(["validate", "hydrostatic-2d", "--out", str(tmp_path)]) == 0
     machine = _strict((tmp_path / "validation.json").read_text())["machine"]
-    assert machine == bench.machine_line()
-    assert machine.startswith(bench.cpu_model() + ", ") and " cores, " in machine
+    assert machine == host.machine_line()
+    assert machine.startswith(host.cpu_model() + ", ") and " cores, " in machine
     assert f"Machine: {machine};" in (tmp_path / "validation.md").read_text()
 
 

@@ -21,8 +21,8 @@ from ..config import PresetError  # noqa: E402
 from ..core.health import InstabilityError  # noqa: E402
 from ..core.params import ParameterError  # noqa: E402
 from ..render.window import RenderError  # noqa: E402
-from .common import (EXIT_INTERRUPTED, EXIT_UNSTABLE, PROG, Fmt, Parser,  # noqa: E402
-                     UsageError, backend_options, error, parameter_message)
+from .common import (EXIT_INTERRUPTED, EXIT_PIPE, EXIT_UNSTABLE, PROG, Fmt,  # noqa: E402
+                     Parser, UsageError, backend_options, error, parameter_message)
 
 # the command modules, in the order `crowndemo --help` lists them
 COMMANDS = ["presets", "info", "run", "record", "export", "play", "live", "scene", "validate",
@@ -81,7 +81,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         # the reader of stdout went away (`crowndemo info ... | head`): no traceback, and
         # nothing more written to the closed pipe, exit flush included
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 141        # 128 + SIGPIPE, as a shell reports a command killed by it
+        return EXIT_PIPE
 
 
 __all__ = ["main", "build_parser", "COMMANDS"]

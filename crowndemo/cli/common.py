@@ -2,8 +2,8 @@
 preset loading, running a simulator with a progress line, and the run summary.
 
 User mistakes (bad flags, parameters out of range, an unavailable arch) print one line
-``crowndemo: error: ...`` on stderr and return 2; an unstable run prints the reason and returns
-EXIT_UNSTABLE (3); Ctrl-C returns EXIT_INTERRUPTED (130).
+``crowndemo: error: ...`` on stderr and return EXIT_USAGE (2); an unstable run prints the reason
+and returns EXIT_UNSTABLE (3); Ctrl-C returns EXIT_INTERRUPTED (130).
 """
 from __future__ import annotations
 
@@ -19,9 +19,12 @@ from ..core.params import Numerics, ParameterError
 from ..interrupt import StopRun, stop_if_asked
 
 PROG = "crowndemo"
-# exit statuses besides 0 and 2 (error() below), the same for every command
+# exit statuses besides 0, the same for every command (MAIN_EPILOG in cli/__init__ lists them)
+EXIT_FAILED = 1             # a recording's video could not be made, or a validation check failed
+EXIT_USAGE = 2              # a usage or parameter error (error() below): "error: ..."
 EXIT_UNSTABLE = 3           # the run broke a health limit (InstabilityError): "unstable: ..."
 EXIT_INTERRUPTED = 130      # stopped by Ctrl-C (128 + SIGINT, as a shell reports it)
+EXIT_PIPE = 141             # stdout closed early (128 + SIGPIPE, as a shell reports it)
 PROGRESS_EVERY_S = 2.0
 NUMERICS = Numerics()       # the core's defaults, shown in --help
 
@@ -311,7 +314,7 @@ def repo_root() -> str:
 
 def error(message: str) -> int:
     print(f"{PROG}: error: {message}", file=sys.stderr)
-    return 2
+    return EXIT_USAGE
 
 
 def parameter_message(e: ParameterError) -> str:

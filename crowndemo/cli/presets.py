@@ -8,7 +8,7 @@ import os
 from .. import strictjson
 from ..config import PresetError
 from ..core.params import ParameterError
-from .common import (Fmt, error)
+from .common import EXIT_USAGE, Fmt, error
 
 
 PRESETS_EPILOG = """\
@@ -120,7 +120,7 @@ def _presets(args) -> int:
             print(line)
     for e in errors:
         error(str(e))
-    return 2 if errors else 0
+    return EXIT_USAGE if errors else 0
 
 
 def register(sub, common) -> None:

@@ -11,8 +11,8 @@ from typing import List, Optional
 
 from ..config import DEFAULT_QUALITY
 from ..core.params import ParameterError
-from .common import (CTRL_C_NOTICE, EXIT_INTERRUPTED, EXIT_UNSTABLE, PRESET_HELP, PROG, Fmt,
-                     Progress, UsageError, add_quality, add_sequence_options, add_sets,
+from .common import (CTRL_C_NOTICE, EXIT_FAILED, EXIT_INTERRUPTED, EXIT_UNSTABLE, PRESET_HELP,
+                     PROG, Fmt, Progress, UsageError, add_quality, add_sequence_options, add_sets,
                      load_presets, path_argument, print_summary, require_folder,
                      start_backend)
 
@@ -46,7 +46,6 @@ When the video cannot be made, its files get the .partial names, metadata.json s
 "failed: ..." and the command exits 1.
 """
 
-EXIT_FAILED = 1      # the recording failed otherwise (the video could not be made)
 
 
 def extra_sinks(resolved, folder: Path, args) -> List:

@@ -135,7 +135,7 @@ def _record(base, table: str, out: str, has_image: bool, argv) -> None:
     import datetime
     import shutil
 
-    from ..bench import machine_line
+    from ..machine import machine_line
 
     docs = os.path.join(repo_root(), "docs")
     os.makedirs(docs, exist_ok=True)

@@ -7,8 +7,8 @@ import os
 import shlex
 import sys
 
-from .common import (EXIT_INTERRUPTED, PROG, Fmt, UsageError, add_quality, path_argument,
-                     repo_root, require_folder, start_backend)
+from .common import (EXIT_FAILED, EXIT_INTERRUPTED, PROG, Fmt, UsageError, add_quality,
+                     path_argument, repo_root, require_folder, start_backend)
 
 GROUPS = ("stability", "verdicts")
 INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
@@ -158,7 +158,7 @@ def _write(out, header, rows, stab, verd, ran: dict) -> dict:
 
 
 def _validate(args, argv) -> int:
-    from ..bench import machine_line
+    from ..machine import machine_line
     from ..validate import cases as cases_mod
     from ..validate import report, stability, verdicts
 
@@ -215,7 +215,7 @@ def _validate(args, argv) -> int:
             print(f"{k}: {v}", file=sys.stderr)
     if interrupted:
         return EXIT_INTERRUPTED
-    return 1 if any(not r.passed for r in stab) else 0
+    return EXIT_FAILED if any(not r.passed for r in stab) else 0
 
 
 def _record(result, rows, stab, verd, paths) -> None:
