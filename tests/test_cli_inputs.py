@@ -58,7 +58,7 @@ def test_info_lattice_refuses_an_infinite_dt():
     Taichi started, flushes to 0: the check itself, on the limits it would see."""
     import math
 
-    from crowndemo.cli.info import _check_dt_floor
+    from crowndemo.cli.info_lattice import _check_dt_floor
     from crowndemo.core.params import Numerics, ParameterError, Physics
     physics = Physics(dim=2, l0=1e-3, v_max=1.0, nu=0.0, sigma=0.0)
     with pytest.raises(ParameterError, match="speed"):

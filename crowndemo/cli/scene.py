@@ -11,7 +11,7 @@ from .. import strictjson
 from ..core.params import GRADIENT_FORMS, Numerics, ParameterError
 from ..config.schema import LIQUID_KEYS, SCENE_KEYS
 from .common import (NUMERICS, PROG, Fmt, print_summary, run_result, simulate, start_backend)
-from .info import ceil3, check_range, floor3
+from .ranges import ceil3, check_range, floor3
 
 
 # per scene, by dimension: the defaults of its options (keys are the builders' keywords)
