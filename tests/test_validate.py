@@ -193,6 +193,21 @@ def test_report_without_matplotlib_removes_an_older_plot(tmp_path, monkeypatch):
     assert (tmp_path / "validation.md").exists() and (tmp_path / "validation.csv").exists()
 
 
+def test_plot_tells_every_case_apart_and_pairs_2d_with_3d():
+    """The plot's legend: no two cases share a colour and a line style; a family's 2D and 3D
+    cases share a colour (solid and dashed)."""
+    from crowndemo.validate.cases import all_cases
+    from crowndemo.validate.report import case_styles
+    names = list(all_cases())
+    styles = case_styles(names)
+    assert set(styles) == set(names)
+    assert len(set(styles.values())) == len(names)
+    for name in names:
+        if name.endswith("-2d") and name[:-3] + "-3d" in styles:
+            two, three = styles[name], styles[name[:-3] + "-3d"]
+            assert two == (two[0], "-") and three == (two[0], "--")
+
+
 def test_report_plot_with_nothing_to_plot_says_why(tmp_path):
     pytest.importorskip("matplotlib")
     from crowndemo.validate.report import plot

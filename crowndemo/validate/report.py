@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from typing import IO, Any, Dict, Iterable, List, Optional, Sequence
+from typing import IO, Any, Dict, Iterable, List, Optional, Sequence, Tuple
 
 from .. import strictjson
 
@@ -68,9 +68,27 @@ def write_csv(rows: Sequence, path: str) -> None:
                        ["; ".join(f"{k}={_fmt(v)}" for k, v in d["extra"].items())])
 
 
+# the last part of a case's name says which member of its family it is: a family (the same
+# physics) shares a colour, its members differ in line style (2D solid, 3D dashed)
+MEMBER_STYLES = {"-2d": "-", "-3d": "--", "-quick": "-", "-3m-drop": "--"}
+
+
+def case_styles(names: Iterable[str]) -> Dict[str, Tuple[str, str]]:
+    """(matplotlib colour, line style) for each case name: one colour per family, in the order
+    families first appear in sorted names, and the line style of its member suffix."""
+    styles: Dict[str, Tuple[str, str]] = {}
+    families: Dict[str, int] = {}
+    for name in sorted(names):
+        suffix = next((s for s in MEMBER_STYLES if name.endswith(s)), "")
+        family = families.setdefault(name[:len(name) - len(suffix)], len(families))
+        styles[name] = (f"C{family % 10}", MEMBER_STYLES.get(suffix, ":"))
+    return styles
+
+
 def plot(rows: Sequence, path: str) -> Optional[str]:
-    """Error against wall time, log-log, one line per case through its base-setting runs and
-    a marker per variant. Returns None when written, else why not."""
+    """Error against wall time, log-log, one line per case through its base-setting runs (its
+    colour and style from ``case_styles``) and a marker per variant. Returns None when
+    written, else why not."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -83,15 +101,16 @@ def plot(rows: Sequence, path: str) -> Optional[str]:
             cases.setdefault(r.case, []).append(r)
     if not cases:                       # nothing for log-log axes
         return "no run with a finite, positive error"
-    fig, ax = plt.subplots(figsize=(8, 5.5))
+    fig, ax = plt.subplots(figsize=(10, 5.5))
     markers = {"f64": "s", "safety/2": "^", "gradient=sum": "D", "gradient=seed": "v",
                "untrimmed": "P", "plane-floor": "<", "relative-courant": ">"}
-    for i, (name, rs) in enumerate(sorted(cases.items())):
-        colour = f"C{i % 10}"
+    styles = case_styles(cases)
+    for name, rs in sorted(cases.items()):
+        colour, line = styles[name]
         base = sorted((r for r in rs if r.variant == "base"), key=lambda r: r.wall_s)
         if base:
-            ax.plot([r.wall_s for r in base], [r.error for r in base], "o-", color=colour,
-                    label=name)
+            ax.plot([r.wall_s for r in base], [r.error for r in base], "o", linestyle=line,
+                    color=colour, label=name)
         for r in rs:
             if r.variant != "base":
                 ax.plot(r.wall_s, r.error, markers.get(r.variant, "x"), color=colour,
@@ -103,7 +122,7 @@ def plot(rows: Sequence, path: str) -> Optional[str]:
     ax.set_xlabel("wall time without JIT compile (s)")
     ax.set_ylabel("relative error")
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))   # beside the data
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
