@@ -164,3 +164,42 @@ def test_missing_presets_folder_is_an_error(tmp_path, monkeypatch, capsys, cmd):
     assert captured.err == (f"crowndemo: error: $CROWNDEMO_PRESETS: no such folder: {missing}; "
                             "allowed: an existing folder of preset .yaml files, or unset for "
                             "presets/ next to the crowndemo package\n")
+
+
+# ---- found by feeding every key extreme values through `info PRESET --set` --------------------
+def test_a_tiny_safety_number_is_named_as_the_cause():
+    """A preset's own safety number that shrinks dt under DT_FLOOR is the key the error names,
+    with the smallest value that passes (each limit is linear in its number); the approach
+    limit (courant_speed: relative) used to raise a KeyError on numerics.dt_max."""
+    from crowndemo.config.resolve import DT_FLOOR
+    base = config.load("3m-drop")                  # courant_speed: relative
+    assert base.numerics.courant_speed == "relative"
+    for key in ("approach", "courant", "acoustic"):
+        with pytest.raises(config.PresetError) as e:
+            config.load("3m-drop", sets=[f"numerics.{key}=1e-9"])
+        assert (e.value.source, e.value.key) == ("--set", f"numerics.{key}")
+        assert f"bound by the {key} limit" in e.value.why
+        need = float(e.value.allowed.split()[1])
+        # the limit at the default number, scaled to the bound, is just above DT_FLOOR
+        at_default = base.limits()[key] / getattr(base.numerics, key)
+        assert DT_FLOOR <= at_default * need <= DT_FLOOR * 1.002
+        assert config.load("3m-drop", sets=[f"numerics.{key}={need}"]).dt()[0] >= DT_FLOOR
+
+
+def test_dt_max_below_the_floor_names_dt_max():
+    with pytest.raises(config.PresetError) as e:
+        config.load("quick", sets=["numerics.dt_max=1e-9"])
+    assert (e.value.key, e.value.allowed) == ("numerics.dt_max", ">= 1e-08 s")
+
+
+@pytest.mark.parametrize("key", ["scene.frame_interval", "quality.draft.frame_interval"])
+def test_more_frames_than_an_hour_of_video_is_refused_before_listing_them(key):
+    """A frame interval of 1e-30 s planned 2e27 frames: `info` filled 23 GB and was killed."""
+    from crowndemo.config.resolve import MAX_FRAMES
+    with pytest.raises(config.PresetError) as e:
+        config.load("quick", sets=[f"{key}=1e-30"])
+    r = config.load("quick")
+    assert e.value.key == key and f"more than {MAX_FRAMES:,}" in e.value.why
+    bound = float(e.value.allowed.split(" = ")[-1].split()[0])
+    assert len(config.load("quick", sets=[f"{key}={bound}"]).frame_times()) <= MAX_FRAMES
+    assert bound == pytest.approx(r.t_end / MAX_FRAMES, rel=1e-3)

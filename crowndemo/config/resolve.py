@@ -22,6 +22,8 @@ if TYPE_CHECKING:
 SPEED_MAX = 50.0        # m/s: beyond this the explicit step is not meant to serve
 DT_FLOOR = 1.0e-8       # s: a time step below this is refused (billions of steps)
 MIN_ACROSS = 3          # particles across the film and across the drop
+MAX_FRAMES = 100_000    # frames a run may plan: an hour of video at 30 frames/s
+SAFETY_LIMITS = ("courant", "approach", "acoustic", "viscous", "capillary")   # dt ~ the number
 # estimate.rough_total is 0.84-1.03 of the scene's particle count (every preset at every
 # quality, 2026-11-23): past this many times the limit a scene is refused before it is built
 ROUGH_MARGIN = 1.1
@@ -131,7 +133,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
     where: Dict[str, Tuple[str, str]] = {}
 
     def fail(name: str, value, why: str, allowed: str):
-        key, source = where[name]
+        key, source = where.get(name, (name, DEFAULT_SOURCE))
         if source == DEFAULT_SOURCE:      # nobody set it: the fix goes into this file
             source = doc.label
         raise PresetError(source, key, value, why, allowed)
@@ -198,6 +200,11 @@ def resolve(doc: Document, quality: str) -> Resolved:
             1 + 1e-9):
         fail("frame_interval", scene["frame_interval"], "longer than the run",
              f"<= t_end = {scene['t_end']:g} s")
+    if scene.get("frame_interval") and scene["t_end"] / scene["frame_interval"] > MAX_FRAMES:
+        fi, t_end = scene["frame_interval"], scene["t_end"]
+        fail("frame_interval", fi, f"{t_end:g} s / {fi:g} s would plan {t_end / fi:.3g} "
+             f"frames, more than {MAX_FRAMES:,}", f">= t_end / {MAX_FRAMES:,} = "
+             f"{t_end / MAX_FRAMES * 1.0001:.4g} s")
     for what, name, size in (("film", "film", scene["film"]), ("drop", "drop", scene["drop"])):
         across = size / l0
         if math.floor(across + 1e-9) < MIN_ACROSS:
@@ -247,16 +254,22 @@ def resolve(doc: Document, quality: str) -> Resolved:
     if dt < DT_FLOOR and numerics.fixed_dt is None:
         why = (f"the time step would be {dt:.3g} s (bound by the {dt_name} limit), below "
                f"{DT_FLOOR:g} s")
-        if dt_name == "courant":
+        given = getattr(numerics, dt_name, None) if dt_name in SAFETY_LIMITS else None
+        default = getattr(Numerics(), dt_name, None)
+        if "numerics." + dt_name in where and given and dt * default / given >= DT_FLOOR:
+            # the preset's own safety number is what shrinks dt (each limit is linear in it)
+            fail("numerics." + dt_name, given, why, f">= {given * DT_FLOOR / dt * 1.001:.4g} "
+                 f"here (default {default:g})")
+        if dt_name in ("courant", "approach"):
             fail("speed", scene.get("height", scene["speed"]), why,
-                 f"U <= {numerics.courant * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
+                 f"U <= {getattr(numerics, dt_name) * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
         elif dt_name == "acoustic" and "sound_speed_source" in scene:
             # c from the slow drop's floor: the capillary speed falls as 1/sqrt(l0)
             c = scene["sound_speed"]
             need = (DT_FLOOR * c / numerics.acoustic if which == "fall" else
                     (DT_FLOOR * c * math.sqrt(l0) / numerics.acoustic) ** (2.0 / 3.0))
             fail("l0", l0, f"{why}; c = {scene['sound_speed_source']}",
-                 f">= {need * 1.001:.3g} m")
+                 f">= {need * 1.001:.4g} m")
         elif dt_name == "acoustic" and scene.get("sound_speed") is not None:
             fail("sound_speed", scene["sound_speed"], why,
                  f"<= {numerics.acoustic * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
