@@ -203,3 +203,19 @@ def test_more_frames_than_an_hour_of_video_is_refused_before_listing_them(key):
     bound = float(e.value.allowed.split(" = ")[-1].split()[0])
     assert len(config.load("quick", sets=[f"{key}={bound}"]).frame_times()) <= MAX_FRAMES
     assert bound == pytest.approx(r.t_end / MAX_FRAMES, rel=1e-3)
+
+
+@pytest.mark.parametrize("text, why", [
+    ("title: " + "[" * 5000 + "]" * 5000 + "\n", "not valid YAML: nested too deeply"),
+    ("extends: quick\nscene: {speed: " + "9" * 5000 + "}\n",
+     "not valid YAML: a value it cannot read (Exceeds the limit (4300 digits)"),
+])
+def test_yaml_python_cannot_read_is_one_clear_error(tmp_path, capsys, text, why):
+    """Nesting deeper than Python's recursion limit, and an integer longer than it converts
+    (4300 digits), raised a traceback from PyYAML."""
+    path = tmp_path / "odd.yaml"
+    path.write_text(text)
+    assert main(["info", str(path)]) == 2
+    assert _error(capsys).startswith(f"crowndemo: error: {path}: {why}")
+    assert main(["info", "quick", "--set", "scene.speed=" + "9" * 5000]) == 2
+    assert "--set scene.speed: not valid YAML" in _error(capsys)

@@ -68,8 +68,9 @@ def _path_to(node, target, path: Tuple = ()) -> Optional[Tuple]:
 
 
 def load_text(text: str, source: str, prefix: Tuple = ()) -> Any:
-    """Parse YAML; a syntax error or a duplicated key becomes a PresetError naming ``source``
-    (and a duplicated key's path, below ``prefix``: where the text sits in a preset)."""
+    """Parse YAML; a syntax error, a duplicated key, nesting deeper than Python recurses or a
+    number it cannot convert becomes a PresetError naming ``source`` (and a duplicated key's
+    path, below ``prefix``: where the text sits in a preset)."""
     loader = _Loader(text)
     root = None
     try:
@@ -80,6 +81,12 @@ def load_text(text: str, source: str, prefix: Tuple = ()) -> Any:
         raise PresetError(source, ".".join(str(p) for p in path), e.value,
                           f"key given twice in one mapping ({_where(e.mark)})",
                           allowed="each key once") from None
+    except RecursionError:
+        raise PresetError(source, None, why="not valid YAML: nested too deeply") from None
+    except ValueError as e:      # an integer longer than Python converts (4300 digits)
+        raise PresetError(source, None,
+                          why=f"not valid YAML: a value it cannot read ({str(e).split(';')[0]})"
+                          ) from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         problem = getattr(e, "problem", None) or str(e)
