@@ -144,6 +144,30 @@ def test_caption_says_time_speed_and_fall_height():
     assert caption_lines(info, 0.0, "ja")[0] == "二メートル"
 
 
+def test_caption_keys_the_colour_scale():
+    """The caption band shows the colour map with its ends: speed over [0, U], height over
+    [0, h + D], pressure over [0, rho U^2] (render/colours.py); milk has no key."""
+    from crowndemo.render.captions import draw_caption, key_labels
+    from crowndemo.render.colours import ColourScale, colour_map
+    U, h, D, rho = math.sqrt(2 * 9.81 * 2.0), 1e-3, 1e-2, 998.0
+    scale = {m: ColourScale.for_scene(m, U, h, D, rho) for m in ("speed", "height", "pressure",
+                                                                  "milk")}
+    assert key_labels(scale["speed"], "en") == ("speed", "0", "6.26 m/s")
+    assert key_labels(scale["height"], "en") == ("height above the floor", "0", "11 mm")
+    assert key_labels(scale["pressure"], "en") == ("pressure", "0", "39.2 kPa")  # rho U^2
+    assert key_labels(scale["milk"], "en") is None
+    info = CaptionInfo({"en": "Two metres"}, speed=U, gravity=9.81)
+    blank = np.full((360, 640, 3), 30, np.uint8)
+    plain = draw_caption(blank, info, 1e-3)
+    assert np.array_equal(draw_caption(blank, info, 1e-3, scale=scale["milk"]), plain)
+    keyed = draw_caption(blank, info, 1e-3, scale=scale["speed"])
+    changed = np.argwhere(np.any(keyed != plain, axis=2))
+    assert changed[:, 0].max() < 60 and changed[:, 1].min() > 320     # in the band, at the right
+    pixels = {tuple(p) for p in keyed[:60, 320:].reshape(-1, 3)}
+    for end in (0.0, 1.0):
+        assert tuple((255 * colour_map(end)).astype(np.uint8)) in pixels
+
+
 def test_sink_writes_frames_video_and_preview(renderer, tmp_path):
     r = config.load("quick-2d", "draft", ["quality.draft.l0=2e-4", "scene.t_end=2e-4",
                                           "scene.frame_interval=5e-5"])

@@ -1,5 +1,6 @@
 """Text on images, with Pillow: the caption of each frame (preset title, simulated time, drop
-speed and fall height) and the title cards of the booth loop, in English or Japanese.
+speed and fall height, and the key of the colour scale) and the title cards of the booth loop,
+in English or Japanese.
 
 Japanese needs a CJK font. One is looked for in the usual Debian places (fonts-ipafont-gothic,
 fonts-noto-cjk, ...) or taken from $CROWNDEMO_FONT; without one, Japanese text falls back to
@@ -16,6 +17,8 @@ from typing import TYPE_CHECKING, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
+
+from .colours import ColourScale, colour_map
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -40,6 +43,10 @@ DIM_TEXT = (190, 196, 205)
 BAND = (0, 0, 0, 150)
 CARD_BACKGROUND = (14, 16, 22)
 MARKER = (230, 80, 60)
+# the colour key's name of each scaled colour field (milk has no scale to show)
+KEY_NAMES = {"speed": {"en": "speed", "ja": "速さ"},
+             "height": {"en": "height above the floor", "ja": "床からの高さ"},
+             "pressure": {"en": "pressure", "ja": "圧力"}}
 _warned = False
 
 
@@ -121,9 +128,43 @@ def caption_lines(info: CaptionInfo, time: float, lang: str) -> List[str]:
     return [text_in(info.title, "en"), "   ".join(parts)]
 
 
+def key_labels(scale: ColourScale, lang: str) -> Optional[Tuple[str, str, str]]:
+    """(name, low end, high end) of the colour key for ``scale``, or None (milk: no scale)."""
+    if scale.mode not in KEY_NAMES:
+        return None
+    unit = {"speed": (1.0, "m/s"), "height": (1e3, "mm"), "pressure": (1e-3, "kPa")}
+    factor, name = unit[scale.mode]
+    return (KEY_NAMES[scale.mode][lang], f"{scale.lo * factor:.3g}",
+            f"{scale.hi * factor:.3g} {name}")
+
+
+def _colour_key(d: ImageDraw.ImageDraw, overlay: Image.Image, scale: ColourScale, lang: str,
+                f, pad: int, band_h: int) -> None:
+    """The colour map as a bar at the right of the caption band, on the level of its second
+    line, between its low and high ends, with its name above it."""
+    labels = key_labels(scale, lang)
+    if labels is None:
+        return
+    name, lo, hi = labels
+    width = overlay.width // 6
+    bar_h = max(4, f.size * 2 // 3)
+    middle = band_h - pad - f.size // 2              # the second line's middle
+    right = overlay.width - 2 * pad - int(d.textlength(hi, font=f)) - pad
+    left, top = right - width, middle - bar_h // 2
+    ramp = (255 * colour_map(np.linspace(0.0, 1.0, width))).astype(np.uint8)
+    strip = np.repeat(ramp[None], bar_h, axis=0)
+    overlay.paste(Image.fromarray(np.dstack([strip, np.full(strip.shape[:2], 255, np.uint8)]),
+                                  "RGBA"), (left, top))
+    d.text((left - pad, middle), lo, font=f, fill=DIM_TEXT, anchor="rm")
+    d.text((right + pad, middle), hi, font=f, fill=DIM_TEXT, anchor="lm")
+    d.text(((left + right) // 2, top - pad // 2), name, font=f, fill=TEXT, anchor="mb")
+
+
 def draw_caption(image: np.ndarray, info: CaptionInfo, time: float, lang: str = "en",
-                 marker: Optional[str] = None) -> np.ndarray:
-    """The image (h, w, 3 uint8) with a caption band across its top; a new array."""
+                 marker: Optional[str] = None,
+                 scale: Optional[ColourScale] = None) -> np.ndarray:
+    """The image (h, w, 3 uint8) with a caption band across its top (with the key of
+    ``scale``, the particles' colours, at its right); a new array."""
     lang = effective_lang(lang)
     img = Image.fromarray(image).convert("RGBA")
     h = img.height
@@ -136,6 +177,8 @@ def draw_caption(image: np.ndarray, info: CaptionInfo, time: float, lang: str = 
     d.rectangle([0, 0, img.width, band_h], fill=BAND)
     d.text((pad * 2, pad), title, font=big, fill=TEXT)
     d.text((pad * 2, pad * 2 + big.size), line, font=small, fill=DIM_TEXT)
+    if scale is not None:
+        _colour_key(d, overlay, scale, lang, small, pad, band_h)
     if marker:
         _marker(d, img.size, marker, small, pad)
     return np.asarray(Image.alpha_composite(img, overlay).convert("RGB"))
@@ -188,4 +231,4 @@ def title_card(size: Tuple[int, int], title: Union[str, Dict[str, str], None],
 
 
 __all__ = ["LANGS", "CJK_HINT", "CaptionInfo", "caption_lines", "draw_caption", "title_card", "mark",
-           "cjk_font_path", "effective_lang", "font", "text_in"]
+           "cjk_font_path", "effective_lang", "font", "text_in", "key_labels"]

@@ -3,6 +3,7 @@
 Scales are fixed for a whole run (not stretched frame by frame) so that a colour means the same
 thing in every frame: speed over [0, U], height over [0, h + D], pressure over [0, rho U^2];
 ``milk`` is a white-ish colour, slightly brighter with height, that the lighting shades.
+The caption's colour key (render/captions.py) shows the scale's ends.
 """
 from __future__ import annotations
 

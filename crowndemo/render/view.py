@@ -71,7 +71,8 @@ class PresetView:
         """One captioned frame (h, w, 3 uint8) of ``state`` at simulated ``time``."""
         img = renderer.render(state, pose or self.pose(index), self.scale, self.radius,
                               self.floor)
-        return draw_caption(img, self.caption, time, self.settings.lang, self.marker)
+        return draw_caption(img, self.caption, time, self.settings.lang, self.marker,
+                            self.scale)
 
 
 __all__ = ["RenderSettings", "PresetView", "SPHERE"]
