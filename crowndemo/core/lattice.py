@@ -14,7 +14,7 @@ import numpy as np
 from .params import ParameterError
 
 # l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
-# user's spacing is checked against its command's own, narrower range first (cli/info.py)
+# user's spacing is checked against its command's own, narrower range first (cli/info_lattice.py)
 L0_FLOAT_RANGE = (1.0e-100, 1.0e100)
 
 
