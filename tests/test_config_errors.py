@@ -219,3 +219,28 @@ def test_yaml_python_cannot_read_is_one_clear_error(tmp_path, capsys, text, why)
     assert _error(capsys).startswith(f"crowndemo: error: {path}: {why}")
     assert main(["info", "quick", "--set", "scene.speed=" + "9" * 5000]) == 2
     assert "--set scene.speed: not valid YAML" in _error(capsys)
+
+
+def test_a_wide_drop_on_a_thin_film_is_estimated_without_building_it():
+    """A coarse build must keep 3 particles across the film: for a 50 mm drop on a 0.1 mm
+    film at l0 = 10 um that build alone held 3.4e9 particles and `info` asked numpy for
+    25 GB. Past BUILD_AT_MOST the counts come from the sizes: the drop's volume and the
+    film's over l0^3, the floor's wall layers over its area."""
+    import math
+    import tracemalloc
+
+    from crowndemo.config import estimate
+    r = config.load("3m-drop", sets=["quality.draft.l0=1e-5", "scene.film=1e-4",
+                                     "scene.drop=0.05"])
+    tracemalloc.start()
+    p = estimate.particle_counts(r)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 50e6                                          # bytes: nothing was built
+    assert not p["exact"] and p["built_l0"] is None
+    assert p["n_drop"] == pytest.approx(math.pi / 6 * 0.05 ** 3 / 1e-5 ** 3, rel=1e-9)
+    area = math.pi * p["extent_m"] ** 2      # the film's disc: the reach, or half the floor
+    assert p["n_film"] == pytest.approx(area * 1e-4 / 1e-5 ** 3, rel=1e-9)
+    assert p["total"] > r.max_particles()                       # info says it is refused
+    with pytest.raises(config.PresetError, match="more than the"):
+        r.build_scene()

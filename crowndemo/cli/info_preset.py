@@ -168,7 +168,9 @@ def info_preset(args) -> int:
             mark = "  <- binds" if name in f["binding_ties"] else ""
             print(f"    {name:<10} {rules[name]:<34} {v:11.4g} s{mark}")
     approx = "" if p["exact"] else "~"
-    how = ("" if p["exact"] else f"; scaled from the scene built at l0 = {_mm(p['built_l0'])}")
+    how = ("" if p["exact"] else f"; scaled from the scene built at l0 = {_mm(p['built_l0'])}"
+           if p["built_l0"] else "; from the sizes alone: resolving the film, even a coarser "
+           "build would be too large")
     print(f"  particles   {approx}{p['fluid']:,} fluid (film {p['n_film']:,}, drop "
           f"{p['n_drop']:,}), {approx}{p['wall']:,} wall, {approx}{p['dummy']:,} dummy "
           f"({approx}{p['total']:,} total{how})")

@@ -34,6 +34,8 @@ from .resolve import Resolved
 
 EXACT_UP_TO = 1.5e6          # total particles: build the scene itself up to this many
 SCALE_FROM = 5.0e5           # otherwise build about this many and scale
+BUILD_AT_MOST = 3.0e6        # a coarse build that must resolve a thin film may hold this many;
+                             # past it the counts come from the sizes alone (rough_counts)
 # used when BENCHMARKS.md cannot be read (the 2026-11-22 CPU figures: AMD EPYC, 2 cores)
 FALLBACK_RATE = 8.0e5        # fluid particle-steps/s, 3D, f32
 FALLBACK_COMPILE_S = 5.0
@@ -131,7 +133,9 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
                 "extent_m": sc.info.get("extent_m")}
     d, h, D = r.dim, r.scene["film"], r.scene["drop"]
     l0c = r.l0 * (rough / scale_from) ** (1.0 / d)
-    l0c = min(l0c, min(h, D) / 3.0)
+    l0c = min(l0c, min(h, D) / 3.0)           # the builder needs 3 particles across each
+    if rough * (r.l0 / l0c) ** d > BUILD_AT_MOST:     # a thin film under a wide drop
+        return rough_counts(r)
     sc = r.build_scene(l0=l0c)
     c = sc.counts()
     k = l0c / r.l0
@@ -152,8 +156,9 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
             "extent_m": sc.info.get("extent_m")}
 
 
-def rough_total(r: Resolved) -> float:
-    """Particles of the scene from its sizes alone (fluid volume and floor area over l0^d)."""
+def _rough_parts(r: Resolved) -> Dict:
+    """Film, drop and wall-layer particles from the scene's sizes alone (volumes and floor
+    area over l0^d), with the film's extent and whether it is trimmed."""
     from ..scenes.crown import reach_radius
     s, d, l0 = r.scene, r.dim, r.l0
     half = s["floor"] / 2
@@ -162,10 +167,31 @@ def rough_total(r: Resolved) -> float:
     e = reach if trimmed else half
     area = (math.pi * e * e) if d == 3 else 2 * e          # floor area (length in 2D)
     drop = math.pi / 6 * s["drop"] ** 3 if d == 3 else math.pi / 4 * s["drop"] ** 2
-    fluid = (area * s["film"] + drop) / l0 ** d
     layers = math.ceil(s["re_ratio"])
-    walls = area / l0 ** (d - 1) * layers * (1.0 if trimmed else 1.5)
-    return fluid + walls
+    return {"film": area * s["film"] / l0 ** d, "drop": drop / l0 ** d,
+            "walls": area / l0 ** (d - 1) * layers * (1.0 if trimmed else 1.5),
+            "layers": layers, "trimmed": trimmed, "extent_m": e}
+
+
+def rough_total(r: Resolved) -> float:
+    """Particles of the scene from its sizes alone (fluid volume and floor area over l0^d)."""
+    parts = _rough_parts(r)
+    return parts["film"] + parts["drop"] + parts["walls"]
+
+
+def rough_counts(r: Resolved) -> Dict:
+    """``particle_counts`` from the sizes alone, for a scene too large to build even at a
+    spacing that still resolves its film: the first wall layer is WALL, the rest DUMMY."""
+    parts = _rough_parts(r)
+    wall = int(round(parts["walls"] / parts["layers"]))
+    dummy = int(round(parts["walls"])) - wall
+    fluid = int(round(parts["film"] + parts["drop"]))
+    return {"fluid": fluid, "wall": wall, "dummy": dummy, "total": fluid + wall + dummy,
+            "n_film": int(round(parts["film"])), "n_drop": int(round(parts["drop"])),
+            "exact": False, "built_l0": None,
+            "left_out": ["not listed: the scene is too large to build, even coarsely"],
+            "trimmed": parts["trimmed"],
+            "walls": None, "extent_m": parts["extent_m"]}
 
 
 def steps_to_end(r: Resolved) -> Dict:
