@@ -156,6 +156,9 @@ def test_caption_keys_the_colour_scale():
     assert key_labels(scale["height"], "en") == ("height above the floor", "0", "11 mm")
     assert key_labels(scale["pressure"], "en") == ("pressure", "0", "39.2 kPa")  # rho U^2
     assert key_labels(scale["milk"], "en") is None
+    from crowndemo.render.captions import key_text          # live mode's panel line
+    assert key_text(scale["speed"], "en") == "colours: speed 0 (blue) to 6.26 m/s (red)"
+    assert key_text(scale["milk"], "en") is None
     info = CaptionInfo({"en": "Two metres"}, speed=U, gravity=9.81)
     blank = np.full((360, 640, 3), 30, np.uint8)
     plain = draw_caption(blank, info, 1e-3)

@@ -138,6 +138,18 @@ def key_labels(scale: ColourScale, lang: str) -> Optional[Tuple[str, str, str]]:
             f"{scale.hi * factor:.3g} {name}")
 
 
+def key_text(scale: ColourScale, lang: str) -> Optional[str]:
+    """The colour key in one line of text (live mode's panel): 'colours: speed 0 (blue) to
+    6.26 m/s (red)'; None for milk."""
+    labels = key_labels(scale, lang)
+    if labels is None:
+        return None
+    name, lo, hi = labels
+    if lang == "ja":
+        return f"色: {name} {lo}（青）〜 {hi}（赤）"
+    return f"colours: {name} {lo} (blue) to {hi} (red)"
+
+
 def _colour_key(d: ImageDraw.ImageDraw, overlay: Image.Image, scale: ColourScale, lang: str,
                 f, pad: int, band_h: int) -> None:
     """The colour map as a bar at the right of the caption band, on the level of its second
@@ -231,4 +243,4 @@ def title_card(size: Tuple[int, int], title: Union[str, Dict[str, str], None],
 
 
 __all__ = ["LANGS", "CJK_HINT", "CaptionInfo", "caption_lines", "draw_caption", "title_card", "mark",
-           "cjk_font_path", "effective_lang", "font", "text_in", "key_labels"]
+           "cjk_font_path", "effective_lang", "font", "text_in", "key_labels", "key_text"]

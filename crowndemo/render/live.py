@@ -7,7 +7,7 @@ import time
 from typing import Optional
 
 from . import camera
-from .captions import caption_lines, text_in
+from .captions import caption_lines, key_text, text_in
 from .live_control import LiveController
 from .renderer import Renderer
 from .view import PresetView, RenderSettings
@@ -56,6 +56,9 @@ def run_live(controller: LiveController, settings: RenderSettings = RenderSettin
                     controller.drop()
                 for line in caption_lines(view.caption, controller.time, lang)[1:]:
                     g.text(line)
+                key = key_text(view.scale, lang)
+                if key:
+                    g.text(key)
                 g.text(controller.status)
                 if controller.error:
                     g.text(controller.error[:300])
