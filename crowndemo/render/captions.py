@@ -43,10 +43,11 @@ DIM_TEXT = (190, 196, 205)
 BAND = (0, 0, 0, 150)
 CARD_BACKGROUND = (14, 16, 22)
 MARKER = (230, 80, 60)
-# the colour key's name of each scaled colour field (milk has no scale to show)
-KEY_NAMES = {"speed": {"en": "speed", "ja": "速さ"},
-             "height": {"en": "height above the floor", "ja": "床からの高さ"},
-             "pressure": {"en": "pressure", "ja": "圧力"}}
+# the colour key of each scaled colour field: its name, and the factor and unit its ends are
+# shown in (milk has no scale to show)
+KEYS = {"speed": ({"en": "speed", "ja": "速さ"}, 1.0, "m/s"),
+        "height": ({"en": "height above the floor", "ja": "床からの高さ"}, 1e3, "mm"),
+        "pressure": ({"en": "pressure", "ja": "圧力"}, 1e-3, "kPa")}
 _warned = False
 
 
@@ -130,12 +131,10 @@ def caption_lines(info: CaptionInfo, time: float, lang: str) -> List[str]:
 
 def key_labels(scale: ColourScale, lang: str) -> Optional[Tuple[str, str, str]]:
     """(name, low end, high end) of the colour key for ``scale``, or None (milk: no scale)."""
-    if scale.mode not in KEY_NAMES:
+    if scale.mode not in KEYS:
         return None
-    unit = {"speed": (1.0, "m/s"), "height": (1e3, "mm"), "pressure": (1e-3, "kPa")}
-    factor, name = unit[scale.mode]
-    return (KEY_NAMES[scale.mode][lang], f"{scale.lo * factor:.3g}",
-            f"{scale.hi * factor:.3g} {name}")
+    names, factor, unit = KEYS[scale.mode]
+    return names[lang], f"{scale.lo * factor:.3g}", f"{scale.hi * factor:.3g} {unit}"
 
 
 def key_text(scale: ColourScale, lang: str) -> Optional[str]:
