@@ -1,13 +1,14 @@
 # Every target sets up what it needs when missing (idempotent): a local .venv with the
-# package and its test extra, and a Vulkan driver for GGUI (Debian's mesa-vulkan-drivers).
+# package and its test extra, a Vulkan driver for GGUI (Debian's mesa-vulkan-drivers) and a
+# Japanese font for --lang ja (Debian's fonts-ipafont-gothic).
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.crowndemo-installed
 
-.PHONY: setup vulkan demo test validate bench device-wheels clean
+.PHONY: setup vulkan fonts demo test validate bench device-wheels clean
 
-setup: $(STAMP) vulkan
+setup: $(STAMP) vulkan fonts
 
 # Taichi 1.7.4 has wheels for Python 3.9-3.12 (pyproject's requires-python); a .venv left
 # without a working pip (an interrupted or failed set-up) is made again; Debian splits venv
@@ -41,6 +42,19 @@ vulkan:
 	   (apt-get update -qq && apt-get install -y -qq mesa-vulkan-drivers >/dev/null)); \
 	else \
 	  echo "warning: no Vulkan driver found; install mesa-vulkan-drivers (Debian) for offscreen rendering"; \
+	fi
+
+# Japanese captions and title cards (--lang ja) need a CJK font: where the package's own lookup
+# (crowndemo/render/captions.py) finds none, IPA Gothic (3.5 MB download, 12.5 MB installed).
+fonts: $(STAMP)
+	@if $(PY) -c 'import sys; from crowndemo.render.captions import cjk_font_path; sys.exit(cjk_font_path() is None)' >/dev/null 2>&1; then \
+	  true; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "installing fonts-ipafont-gothic (a Japanese font for --lang ja)"; \
+	  (apt-get install -y -qq --no-install-recommends fonts-ipafont-gothic >/dev/null 2>&1 || \
+	   (apt-get update -qq && apt-get install -y -qq --no-install-recommends fonts-ipafont-gothic >/dev/null)); \
+	else \
+	  echo "warning: no Japanese font found; install fonts-ipafont-gothic or fonts-noto-cjk (Debian) for --lang ja"; \
 	fi
 
 demo: setup

@@ -2,14 +2,18 @@
 speed and fall height, and the key of the colour scale) and the title cards of the booth loop,
 in English or Japanese.
 
-Japanese needs a CJK font. One is looked for in the usual Debian places (fonts-ipafont-gothic,
-fonts-noto-cjk, ...) or taken from $CROWNDEMO_FONT; without one, Japanese text falls back to
-English with a one-time warning that says how to install a font.
+Japanese needs a CJK font: $CROWNDEMO_FONT, else one in the usual Debian places
+(fonts-ipafont-gothic, which `make` installs, fonts-noto-cjk, ...), else any font fontconfig
+lists for Japanese; a font is taken only if it draws Japanese (two different kanji must not come
+out as the same bitmap, a missing-glyph box). Without one, Japanese text falls back to English
+with a one-time warning that says how to install a font.
 """
 from __future__ import annotations
 
+import functools
 import glob
 import os
+import subprocess
 import sys
 import textwrap
 from dataclasses import dataclass
@@ -33,11 +37,15 @@ CJK_FONTS = ("/usr/share/fonts/opentype/ipafont-gothic/ipagp.ttf",
              "/usr/share/fonts/opentype/noto/NotoSansCJKjp-Regular.otf",
              "/usr/share/fonts/truetype/vlgothic/VL-PGothic-Regular.ttf",
              "/usr/share/fonts/truetype/droid/DroidSansFallbackFull.ttf")
-CJK_GLOBS = ("/usr/share/fonts/**/*ipag*.ttf", "/usr/share/fonts/**/*CJK*.tt[cf]",
-             "/usr/share/fonts/**/*CJK*.otf")
+CJK_GLOBS = ("/usr/share/fonts/**/*ipag*.ttf", "/usr/share/fonts/**/*CJK*-Regular.tt[cf]",
+             "/usr/share/fonts/**/*CJK*.tt[cf]", "/usr/share/fonts/**/*CJK*.otf")
+FC_LIST = "fc-list"        # fontconfig's lister: the fonts it knows for a language
 CJK_HINT = ("no Japanese (CJK) font found, so Japanese text is shown in English; install one "
-            "with 'apt-get install fonts-ipafont-gothic' (about 12 MB installed) or point "
-            "$CROWNDEMO_FONT at a .ttf/.otf/.ttc file")
+            "with 'apt-get install fonts-ipafont-gothic' (3.5 MB download, 12.5 MB installed; "
+            "'make setup' does this as root) or point $CROWNDEMO_FONT at a .ttf/.otf/.ttc file "
+            "with Japanese glyphs")
+KANJI_PAIR = ("速", "圧")    # two different kanji of the captions: a font without them draws both
+                             # as the same missing-glyph box (or nothing)
 TEXT = (240, 240, 240)
 DIM_TEXT = (190, 196, 205)
 BAND = (0, 0, 0, 150)
@@ -51,18 +59,51 @@ KEYS = {"speed": ({"en": "speed", "ja": "速さ"}, 1.0, "m/s"),
 _warned = False
 
 
-def cjk_font_path() -> Optional[str]:
-    env = os.environ.get("CROWNDEMO_FONT")
-    if env and os.path.isfile(env):
-        return env
-    for path in CJK_FONTS:
-        if os.path.isfile(path):
+def draws_japanese(path: str) -> bool:
+    """Whether the font file draws Japanese: the two kanji of KANJI_PAIR come out as different,
+    non-empty bitmaps (a font without them gives the same missing-glyph box, or nothing)."""
+    try:
+        f = ImageFont.truetype(path, 32)
+    except OSError:                       # not a font file Pillow can read
+        return False
+    a, b = (np.asarray(f.getmask(ch), dtype=np.uint8) for ch in KANJI_PAIR)
+    if not a.any() or not b.any():
+        return False
+    return a.shape != b.shape or bool((a != b).any())
+
+
+def _fontconfig_japanese(fc_list: str) -> List[str]:
+    """The font files fontconfig lists as covering Japanese (none without fontconfig)."""
+    try:
+        out = subprocess.run([fc_list, ":lang=ja", "file"], capture_output=True, text=True,
+                             timeout=20).stdout
+    except (OSError, subprocess.SubprocessError):
+        return []
+    return sorted({line.split(":")[0].strip() for line in out.splitlines() if line.strip()})
+
+
+@functools.lru_cache(maxsize=8)
+def _find_cjk(env: Optional[str], paths: Tuple[str, ...], patterns: Tuple[str, ...],
+              fc_list: str) -> Optional[str]:
+    def candidates():
+        if env:
+            yield env
+        yield from paths
+        for pattern in patterns:
+            yield from sorted(glob.glob(pattern, recursive=True))
+        yield from _fontconfig_japanese(fc_list)
+    for path in candidates():
+        if os.path.isfile(path) and draws_japanese(path):
             return path
-    for pattern in CJK_GLOBS:
-        found = sorted(glob.glob(pattern, recursive=True))
-        if found:
-            return found[0]
     return None
+
+
+def cjk_font_path() -> Optional[str]:
+    """The font file for Japanese text, or None: $CROWNDEMO_FONT, the usual Debian places
+    (CJK_FONTS, CJK_GLOBS), then fontconfig's Japanese fonts; the first that draws Japanese
+    (looked up once per process and value of $CROWNDEMO_FONT)."""
+    return _find_cjk(os.environ.get("CROWNDEMO_FONT") or None, tuple(CJK_FONTS),
+                     tuple(CJK_GLOBS), FC_LIST)
 
 
 def effective_lang(lang: str) -> str:
@@ -242,4 +283,5 @@ def title_card(size: Tuple[int, int], title: Union[str, Dict[str, str], None],
 
 
 __all__ = ["LANGS", "CJK_HINT", "CaptionInfo", "caption_lines", "draw_caption", "title_card", "mark",
-           "cjk_font_path", "effective_lang", "font", "text_in", "key_labels", "key_text"]
+           "cjk_font_path", "draws_japanese", "effective_lang", "font", "text_in", "key_labels",
+           "key_text"]
