@@ -10,11 +10,12 @@ STAMP := $(VENV)/.crowndemo-installed
 
 setup: $(STAMP) vulkan fonts
 
-# Taichi 1.7.4 has wheels for Python 3.9-3.12 (pyproject's requires-python); a .venv left
-# without a working pip (an interrupted or failed set-up) is made again; Debian splits venv
-# into python3-venv, installed here when missing (as root).
+# Taichi 1.7.4 has wheels for Python 3.9-3.12, pysplashsurf for 3.10 on (pyproject's
+# requires-python: 3.10-3.12); a .venv left without a working pip (an interrupted or failed
+# set-up) is made again; Debian splits venv into python3-venv, installed here when missing
+# (as root).
 $(STAMP): pyproject.toml
-	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; sys.exit(0 if (3, 9) <= v < (3, 13) else "error: crowndemo needs Python 3.9 to 3.12 (Taichi 1.7.4 has no wheels for %d.%d); run make with PYTHON=python3.12, say" % v)'
+	@$(PYTHON) -c 'import sys; v = sys.version_info[:2]; sys.exit(0 if (3, 10) <= v < (3, 13) else "error: crowndemo needs Python 3.10 to 3.12 (Taichi 1.7.4 and pysplashsurf have no wheels together for %d.%d); run make with PYTHON=python3.12, say" % v)'
 	@$(PY) -m pip --version >/dev/null 2>&1 || { \
 	  rm -rf $(VENV); \
 	  $(PYTHON) -m venv $(VENV) 2>/dev/null || { \

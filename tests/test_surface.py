@@ -1,0 +1,162 @@
+"""The liquid surface (render/surface.py) against geometry: a ball, a film, a thin sheet,
+droplets, and the mirroring of a quarter or half run into the whole."""
+import math
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pysplashsurf")
+
+from crowndemo.render import meshmeasure as mm  # noqa: E402
+from crowndemo.render.surface import SurfaceParams, plane_axes, reconstruct  # noqa: E402
+
+L0 = 1.0e-4                        # particle spacing, m
+CUBE = SurfaceParams().cube_size(L0)
+
+
+def lattice(lo, hi):
+    """Particles at the centres of the l0-cubes filling the box [lo, hi] (in l0)."""
+    axes = [np.arange(a, b) + 0.5 for a, b in zip(lo, hi)]
+    return np.stack(np.meshgrid(*axes, indexing="ij"), -1).reshape(-1, len(lo)) * L0
+
+
+def ball(radius):
+    """Lattice particles within ``radius`` (in l0) of the origin: each stands for l0^3."""
+    n = int(radius) + 1
+    p = lattice((-n,) * 3, (n,) * 3)
+    return p[np.linalg.norm(p, axis=1) <= radius * L0]
+
+
+def spread_from(a, b):
+    """Largest distance from a point of ``a`` to the nearest point of ``b``."""
+    bb = (b ** 2).sum(1)
+    return max(np.sqrt(max(((c ** 2).sum(1)[:, None] + bb[None] - 2 * c @ b.T).min(1).max(),
+                           0.0)) for c in (a[i:i + 1000] for i in range(0, len(a), 1000)))
+
+
+def test_ball_is_closed_with_the_spheres_volume_and_area():
+    r = 10
+    mesh = reconstruct(ball(r), L0)
+    R = r * L0
+    assert mm.open_edges(mesh.triangles) == 0
+    assert mm.pieces(mesh.n_vertices, mesh.triangles) == 1
+    assert mm.euler(mesh.triangles) == 2                     # a sphere's topology
+    assert mm.volume(mesh.vertices, mesh.triangles) == pytest.approx(4 / 3 * math.pi * R ** 3,
+                                                                      rel=0.05)
+    assert mm.area(mesh.vertices, mesh.triangles) == pytest.approx(4 * math.pi * R ** 2,
+                                                                    rel=0.10)
+    # outward normals of unit length
+    n = mesh.normals
+    assert np.allclose(np.linalg.norm(n, axis=1), 1.0, atol=1e-6)
+    assert (np.einsum("ij,ij->i", n, mesh.vertices) > 0).mean() > 0.99
+
+
+def test_film_is_a_slab_of_its_thickness():
+    layers, half = 3, 15                           # h = 3 l0, 30 l0 square
+    mesh = reconstruct(lattice((-half, -half, 0), (half, half, layers)), L0)
+    v = mesh.vertices
+    centre = np.all(np.abs(v[:, :2]) < 5 * L0, axis=1)        # away from the film's edges
+    top, bottom = v[centre, 2].max(), v[centre, 2].min()
+    assert top - bottom == pytest.approx(layers * L0, abs=L0)
+    assert mm.open_edges(mesh.triangles) == 0
+
+
+@pytest.mark.parametrize("spacing, jitter", [(1.0, 0.0), (2.0, 0.15)])
+def test_thin_sheet_two_particles_thick_stays_one_surface(spacing, jitter):
+    """A crown wall two particles thick, also stretched to 2 l0 between neighbours in its plane
+    and disordered: one closed sheet without holes (a hole would lower V - E + F below 2)."""
+    n = int(30 / spacing)
+    p = lattice((0, 0, 0), (n, n, 2))
+    p[:, :2] *= spacing
+    p += jitter * L0 * np.random.default_rng(22).standard_normal(p.shape)
+    mesh = reconstruct(p, L0)
+    assert mm.pieces(mesh.n_vertices, mesh.triangles) == 1
+    assert mm.euler(mesh.triangles) == 2
+    assert mm.open_edges(mesh.triangles) == 0
+
+
+def test_curved_sheet_stays_one_tube():
+    """A cylindrical crown wall (radius 15 l0, two particles thick, open top and bottom): one
+    surface with the topology of a tube's skin, a torus (V - E + F = 0)."""
+    rings = []
+    for layer in range(2):
+        r = (15 + layer) * L0
+        k = int(2 * math.pi * r / L0)
+        a = np.arange(k) * 2 * math.pi / k
+        for z in range(20):
+            rings.append(np.c_[r * np.cos(a), r * np.sin(a), np.full(k, (z + 0.5) * L0)])
+    mesh = reconstruct(np.concatenate(rings), L0)
+    assert mm.pieces(mesh.n_vertices, mesh.triangles) == 1
+    assert mm.euler(mesh.triangles) == 0
+
+
+def test_spray_droplets_stay_droplets():
+    """Five single particles 3 l0 apart (centre to centre): five closed droplets."""
+    p = np.array([[3.0 * i * L0, 0.0, 0.0] for i in range(5)])
+    mesh = reconstruct(p, L0)
+    assert mm.pieces(mesh.n_vertices, mesh.triangles) == 5
+    assert mm.euler(mesh.triangles) == 2 * 5
+    assert mm.open_edges(mesh.triangles) == 0
+
+
+def test_fields_are_interpolated_to_the_vertices():
+    """A field equal to the height z reads, at each vertex, the height of the particles near
+    it: within the kernel's reach (one support radius) of the vertex's own height."""
+    p = ball(8)
+    mesh = reconstruct(p, L0, {"height": p[:, 2], "one": np.ones(len(p))})
+    assert set(mesh.fields) == {"height", "one"}
+    assert np.allclose(mesh.fields["one"], 1.0, atol=1e-6)
+    err = np.abs(mesh.fields["height"] - mesh.vertices[:, 2])
+    assert err.max() < SurfaceParams().support(L0)
+    # the field follows the height: top vertices read high, bottom ones low
+    assert np.corrcoef(mesh.fields["height"], mesh.vertices[:, 2])[0, 1] > 0.99
+
+
+@pytest.mark.parametrize("planes", [["x"], ["x", "y"]])
+def test_mirrored_part_equals_the_whole(planes):
+    """The mesh of a quarter (or half) ball mirrored into the whole is the full ball's mesh
+    within one cube size, closed, one piece, no seam."""
+    p = ball(10)
+    full = reconstruct(p, L0, {"z": p[:, 2]})
+    part = np.all(p[:, list(plane_axes(planes))] > 0, axis=1)
+    whole = reconstruct(p[part], L0, {"z": p[part, 2]}, planes=planes)
+    assert mm.open_edges(whole.triangles) == 0                 # seamless
+    assert mm.pieces(whole.n_vertices, whole.triangles) == 1
+    assert mm.euler(whole.triangles) == 2
+    assert spread_from(whole.vertices, full.vertices) < CUBE
+    assert spread_from(full.vertices, whole.vertices) < CUBE
+    assert mm.volume(whole.vertices, whole.triangles) == pytest.approx(
+        mm.volume(full.vertices, full.triangles), rel=0.01)
+    # the part alone, cut at the planes, is open exactly there
+    cut = reconstruct(p[part], L0, planes=planes, whole=False)
+    assert cut.vertices[:, list(plane_axes(planes))].min() == 0.0
+    assert mm.open_edges(cut.triangles) > 0
+
+
+def test_slice_is_extruded_and_mirrored():
+    """A 2D disc (x, z) of radius 10 l0 becomes a slab whose outline at y = 0 lies on the
+    circle within one l0; its half run (plane x) mirrors into the same."""
+    r = 10
+    n = r + 1
+    p = lattice((-n, -n), (n, n))
+    p = p[np.linalg.norm(p, axis=1) <= r * L0]
+    full = reconstruct(p, L0)
+    mid = np.abs(full.vertices[:, 1]) < 0.5 * L0
+    rim = np.hypot(full.vertices[mid, 0], full.vertices[mid, 2])
+    assert np.abs(rim[rim > 5 * L0] - r * L0).max() < L0
+    half = reconstruct(p[p[:, 0] > 0], L0, planes=["x"])
+    assert mm.open_edges(half.triangles) == 0
+    assert spread_from(half.vertices, full.vertices) < CUBE
+
+
+def test_plane_names():
+    assert plane_axes(None) == ()
+    assert plane_axes([]) == ()
+    assert plane_axes(["y", "x"]) == (0, 1)
+    with pytest.raises(ValueError, match="allowed: x, y"):
+        plane_axes(["z"])
+
+
+def test_no_particles_no_mesh():
+    mesh = reconstruct(np.zeros((0, 3)), L0, {"speed": np.zeros(0)})
+    assert mesh.n_vertices == 0 and mesh.n_triangles == 0 and "speed" in mesh.fields
