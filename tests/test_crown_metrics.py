@@ -158,3 +158,51 @@ def test_the_rule_looks_inside_the_film_edge_or_the_container_walls():
     assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
     assert m.rim_height == pytest.approx(top - H, abs=L0) and m.crown
     assert film_edge(half, L0) == pytest.approx(0.9 * half)
+
+
+def test_sheet_coherence_of_a_wall_with_isolated_spray():
+    """Issue 21's sheet coherence: the raised liquid (more than 2 l0 above the film) in the
+    one body linked at 1.6 l0, over all raised liquid. A wall standing on the film plus k
+    single particles, each more than 1.6 l0 from every other: exactly n_wall / (n_wall + k)."""
+    R, T, top = 3.0e-3, 3 * L0, H + 2.0e-3
+    wall = shell(R, T, lambda t: top)
+    k = 40
+    a = np.linspace(0, 2 * math.pi, k, endpoint=False)     # 40 points 0.75 mm apart, on a
+    spray = np.stack([6e-3 * np.cos(a), 6e-3 * np.sin(a), np.full(k, H + 3e-3)], axis=1)
+    pts = np.concatenate([film(5.0e-3), wall, spray])      # circle 2 mm above the wall
+    n_wall = int(np.count_nonzero(wall[:, 2] > H + 2 * L0))
+    m = measure(pts, 1e-3, H, D, L0)
+    assert m.raised_particles == n_wall + k
+    assert m.sheet_coherence == pytest.approx(n_wall / (n_wall + k), rel=1e-12)
+    assert measure(np.concatenate([film(5.0e-3), wall]), 1e-3, H, D, L0).sheet_coherence == 1.0
+    assert math.isnan(measure(film(3.0e-3), 0.0, H, D, L0).sheet_coherence)
+
+
+def test_sheet_coherence_links_at_1_6_l0_not_1_5():
+    """A 2D wall whose upper half stands 1.55 l0 from its lower half: linked at 1.6 l0 (one
+    sheet, coherence 1) although the crown rule's 1.5 l0 main body leaves it out; at 1.7 l0
+    apart it is spray of its own (coherence = the lower part's share)."""
+    xs = (np.arange(-50, 50) + 0.5) * L0
+    zs = (np.arange(10) + 0.5) * L0
+    base = np.stack(np.meshgrid(xs, zs, indexing="ij"), axis=-1).reshape(-1, 2)
+    for gap, expect_one in ((1.55, True), (1.7, False)):
+        low = np.arange(0.5 * L0, H + 1e-3, L0)          # 1 mm of wall above the film
+        high = np.arange(low[-1] + gap * L0, H + 2e-3, L0)
+        col = np.concatenate([low, high])
+        wall = np.stack([np.full(len(col), 3e-3), col], axis=1)
+        pts = np.concatenate([base, wall, wall * np.array([-1.0, 1.0])])
+        m = measure(pts, 1e-3, H, D, L0)
+        raised_low = 2 * int(np.count_nonzero(low > H + 2 * L0))
+        raised = raised_low + 2 * len(high)
+        assert m.raised_particles == raised
+        want = 1.0 if expect_one else raised_low / raised
+        assert m.sheet_coherence == pytest.approx(want, rel=1e-12), gap
+
+
+def test_a_drop_above_the_film_is_raised_but_no_crown():
+    """Before contact only the falling drop is raised, apart from the film: no crown, no base
+    radius, coherence 0 (3D; the azimuthal bins used to be sized from a nan radius)."""
+    pts = np.concatenate([film(3.0e-3), ball((0.0, 0.0, H + 2e-3), 1.0e-3)])
+    m = measure(pts, 0.0, H, D, L0)
+    assert not m.crown and math.isnan(m.base_radius) and m.raised_particles > 0
+    assert m.droplets == 1 and m.sheet_coherence == 0.0

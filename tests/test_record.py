@@ -101,6 +101,25 @@ def test_metadata_and_snapshots_of_a_complete_recording(uninterrupted, preset):
     assert not list(res.folder.rglob(".*tmp*"))        # no temporary file left
 
 
+def test_every_frame_carries_its_crown_metrics(uninterrupted, preset):
+    """metadata.json's frames hold the crown metrics (sheet coherence among them) of their
+    snapshot's fluid, as validate.crown_metrics measures them (issue 21: per frame)."""
+    from crowndemo.strictjson import finite_or_none
+    from crowndemo.validate.crown_metrics import measure
+    from crowndemo.validate.verdicts import film_limit
+    res, _ = uninterrupted
+    meta = json.loads((res.folder / files.METADATA).read_text())
+    s = preset.scene
+    edge = film_limit(res.scene.info, preset.l0)
+    for f in meta["frames"]:
+        snap = snapshots.read(res.folder / f["file"])
+        want = measure(snap["pos"], f["time_s"], s["film"], s["drop"], preset.l0, edge=edge)
+        assert f["crown"] == json.loads(json.dumps(finite_or_none(want.as_dict())))
+    assert meta["frames"][0]["crown"]["sheet_coherence"] == 0.0   # only the falling drop is raised
+    last = meta["frames"][-1]["crown"]
+    assert 0.0 <= last["sheet_coherence"] <= 1.0 and last["raised_particles"] > 0
+
+
 def test_ctrl_c_then_resume_is_bit_identical(uninterrupted, preset, tmp_path):
     folder = tmp_path / "quick-2d"
     stop = StopRequest()

@@ -4,6 +4,7 @@
 - ``files``      the recordings/ layout, whether a folder can take one, atomic writes;
 - ``runlog``     frames written, wall times, starts (kept across a resume);
 - ``snapshots``  particles per frame, ``snapshots/frame_00000.npz``;
+- ``crown``      the crown metrics per frame (sheet coherence too), into metadata.json;
 - ``checkpoint`` the restartable state, ``checkpoint.npz``, for ``--resume``;
 - ``metadata``   ``metadata.json``: parameters, counts, dt, health, wall time, status;
 - ``vtk``        ParaView ``.vtp`` per frame + ``.pvd`` (writer and reader);

@@ -13,6 +13,7 @@ from ..interrupt import StopRequest, StopRun, stop_if_asked
 from ..strictjson import finite_or_none
 from . import checkpoint as ckpt
 from . import snapshots
+from .crown import CrownSink
 from .files import CHECKPOINT, METADATA, SNAPSHOTS, PathLike, remove_rendered
 from .metadata import MetadataSink
 from .metadata import read as read_metadata
@@ -142,7 +143,8 @@ def record_preset(resolved: Resolved, out_dir: PathLike, sinks_extra: Sequence =
                   options: Optional[dict] = None) -> RecordResult:
     """Record ``resolved`` (a config.Resolved) into ``out_dir``; returns how it ended.
 
-    ``sinks_extra`` are frame sinks called after the snapshot and before the checkpoint and
+    ``sinks_extra`` are frame sinks called after the snapshot and the crown metrics (which
+    enter the frame's entry of metadata.json's ``frames``) and before the checkpoint and
     metadata. ``resume`` continues from ``out_dir/checkpoint.npz`` (``resume_from``: that
     checkpoint, already loaded by ``resume_point``), raising what ``resume_point`` raises
     (AlreadyComplete, RecordError) before anything is written. ``stop`` is an object whose
@@ -193,7 +195,8 @@ def record_preset(resolved: Resolved, out_dir: PathLike, sinks_extra: Sequence =
                                      start)
     meta = MetadataSink(folder / METADATA, resolved, scene, sim, log, frames, checkpoint_every,
                         be, print_, options)
-    sinks = [snapshots.SnapshotSink(folder, log, fluid_only), *sinks_extra, checkpoint, meta]
+    sinks = [snapshots.SnapshotSink(folder, log, fluid_only), CrownSink(resolved, scene, log),
+             *sinks_extra, checkpoint, meta]
     log.start(sim.stats.steps, time.perf_counter() - t0)
     log.stopped_by = None
     meta.write("running")

@@ -11,7 +11,7 @@ from typing import List, Optional
 
 @dataclass
 class RunLog:
-    frames: List[dict] = field(default_factory=list)   # index, time_s, file, wall_s
+    frames: List[dict] = field(default_factory=list)   # index, time_s, file, wall_s, crown
     setup_seconds: float = 0.0        # summed over the starts
     starts: List[dict] = field(default_factory=list)   # started (UTC), from_step, setup_s
     stopped_by: Optional[str] = None  # "ctrl-c" | "max-steps" when interrupted

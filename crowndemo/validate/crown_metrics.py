@@ -20,6 +20,9 @@ The rules, each a few lines below:
   rim between the fingers when fingers are narrow);
 - rim thickness: per sector, the radial extent (+ l0) of the main body in the top fifth of that
   sector's wall; the median;
+- sheet coherence (issue 21): the fraction of the raised liquid that lies in the largest body
+  of fluid particles linked closer than 1.6 l0 (the film and the crown wall standing on it);
+  1 for a wall that is one sheet, falling as it breaks into spray; nan when nothing is raised;
 - jets: the local maxima of the rim height around the azimuth (bins of about 2 l0 of arc),
   each at least 2 l0 above both neighbouring minima, and ejected droplets do not count (3D);
 - verdict: a crown when a wall stands outside the drop's footprint (base radius > D/2) and
@@ -39,6 +42,7 @@ from .clusters import groups
 RAISED_L0 = 2.0        # raised liquid: more than this many l0 above the film surface
 ROOT_TOP_L0 = 5.0      # the root band of the crown wall ends this many l0 above the surface
 LINK_L0 = 1.5          # particles closer than this many l0 belong to one body
+COHERENCE_LINK_L0 = 1.6   # the sheet-coherence link (issue 21's definition)
 JET_PROMINENCE_L0 = 2.0
 CROWN_MIN_HEIGHT_D = 0.25
 CROWN_MIN_BASE_D = 0.5
@@ -64,6 +68,7 @@ class CrownMetrics:
     raised_particles: int
     crown: bool
     verdict: str                # one line: why crown or no crown
+    sheet_coherence: float = math.nan   # raised liquid in the one body / all raised (0..1)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -118,7 +123,7 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
     nan = math.nan
     if not raised.any():
         return CrownMetrics(time, nan, 0.0, nan, 0, 0, 0, 0, False,
-                            "no crown: nothing stands 2 l0 above the film")
+                            "no crown: nothing stands 2 l0 above the film", nan)
     label = groups(pos, LINK_L0 * l0)
     ids, counts = np.unique(label, return_counts=True)
     main = label == ids[np.argmax(counts)]
@@ -131,6 +136,11 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
         r = np.abs(pos[:, 0])
         theta = np.where(pos[:, 0] >= 0, 0.5 * math.pi, -0.5 * math.pi)
     body = raised & main
+    coherence = sheet_coherence(pos, raised, l0)
+    if not body.any():          # only what is apart from the film is raised (the falling drop)
+        return CrownMetrics(time, nan, 0.0, nan, 0, n_drops, int(drops.sum()),
+                            int(raised.sum()), False, "no crown: nothing raised stands on the "
+                            "film (the liquid above it is apart from it)", coherence)
     root = body & (z < film + ROOT_TOP_L0 * l0)
     if not root.any():
         root = body
@@ -162,4 +172,17 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
                f"{CROWN_MIN_HEIGHT_D * drop * 1e3:.3g} mm) at r = {base * 1e3:.3g} mm (needs > "
                f"D/2), {rim_thickness * 1e3:.2g} mm thick (needs < its height)")
     return CrownMetrics(time, base, rim_height, rim_thickness, jets, n_drops,
-                        int(drops.sum()), int(raised.sum()), bool(crown), why)
+                        int(drops.sum()), int(raised.sum()), bool(crown), why, coherence)
+
+
+def sheet_coherence(pos: np.ndarray, raised: np.ndarray, l0: float) -> float:
+    """The fraction of the ``raised`` particles of ``pos`` (the fluid) that belong to the
+    largest group of fluid particles linked closer than COHERENCE_LINK_L0 l0; nan when none
+    is raised."""
+    n_raised = int(np.count_nonzero(raised))
+    if n_raised == 0:
+        return math.nan
+    label = groups(pos, COHERENCE_LINK_L0 * l0)
+    ids, counts = np.unique(label, return_counts=True)
+    body = label == ids[np.argmax(counts)]
+    return float(np.count_nonzero(raised & body)) / n_raised
