@@ -178,8 +178,8 @@ def test_sink_writes_frames_video_and_preview(renderer, tmp_path):
     assert len(times) == 4
     sim = simulator_for(r.build_scene())
     out = tmp_path / "quick-2d"
-    sink = FrameSink(str(out), PresetView.from_resolved(r, RenderSettings(resolution=RES,
-                                                                          fps=5)), renderer)
+    sink = FrameSink(str(out), PresetView.from_resolved(r, RenderSettings(
+        resolution=RES, fps=5, style="particles")), renderer)     # lit(): the spheres' ground
     sink.frame(sim, 0, 0.0)
     sim.run(r.t_end, times, on_frame=lambda s, i: sink.frame(s, i + 1, times[i]))
     sink.close("complete")

@@ -66,13 +66,15 @@ def _spec(r) -> str:
 
 
 # the options that shape a recording's files: a resumed run must keep those of MATCHED
-MATCHED = ("render", "resolution", "colour", "lang", "orbit", "all_particles")
+MATCHED = ("render", "resolution", "style", "colour", "lang", "orbit", "all_particles")
 
 
 def recording_options(args) -> dict:
     """How the command makes a recording's files (JSON-normal), kept in metadata.json."""
+    from ..render.options import colour_of, style_of
     return {"render": bool(args.render), "resolution": list(args.resolution),
-            "colour": args.colour, "lang": args.lang, "orbit": float(args.orbit),
+            "style": style_of(args), "colour": colour_of(args), "lang": args.lang,
+            "orbit": float(args.orbit),
             "fps": float(args.fps), "video": bool(args.video),
             "all_particles": bool(args.all_particles),
             "checkpoint_every": int(args.checkpoint_every)}
@@ -88,7 +90,9 @@ def _option_words(options: dict) -> List[str]:
     else:
         if tuple(options["resolution"]) != tuple(d.resolution):
             words += ["--resolution", "%dx%d" % tuple(options["resolution"])]
-        if options["colour"] != d.colour:
+        if options.get("style", "particles") != d.style:
+            words += ["--style", options.get("style", "particles")]
+        if options["colour"] != RenderSettings(style=options.get("style", d.style)).colour:
             words += ["--colour", options["colour"]]
         if options["lang"] != d.lang:
             words += ["--lang", options["lang"]]
@@ -260,9 +264,11 @@ def _record(args) -> int:
                       f"{len(res.frame_times)} frames; status {res.status.split(':')[0]}")
             if render and not args.json:
                 t = meta["render"]
+                surface = (f" ({t['surface_seconds_per_frame']:.2f} s of it the surface)"
+                           if t.get("surface_seconds") else "")
                 print(f"  rendering   {t['frames']} frames, {t['render_seconds_per_frame']:.2f} s "
-                      f"a frame against {t['simulation_seconds_per_frame']:.2f} s of simulation "
-                      f"a frame; video and preview {t['encode_seconds']:.1f} s: "
+                      f"a frame{surface} against {t['simulation_seconds_per_frame']:.2f} s of "
+                      f"simulation a frame; video and preview {t['encode_seconds']:.1f} s: "
                       f"{', '.join(os.path.basename(v) for v in t['outputs'].values()) or 'none'}")
             code = _ending(r, res, folder, args, [x.name for x in resolved[i + 1:]])
             if code is not None:

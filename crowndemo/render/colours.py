@@ -51,5 +51,18 @@ def colour_map(t: np.ndarray) -> np.ndarray:
     return COLOUR_MAP[i] * (1 - f) + COLOUR_MAP[i + 1] * f
 
 
+def vertex_colours(scale: ColourScale, height: np.ndarray, fields: dict) -> np.ndarray:
+    """Per-vertex colours (V x 3 float32) of a surface: the mode's value from the fields
+    interpolated to the vertices (speed, pressure) or the vertices' ``height``."""
+    value = np.asarray(fields[scale.mode] if scale.mode in ("speed", "pressure") else height,
+                       float)
+    span = scale.hi - scale.lo
+    t = (value - scale.lo) / span if span > 0 else np.zeros_like(value)
+    if scale.mode == "milk":
+        t = np.clip(t, 0.0, 1.0)[:, None]
+        return (np.float32(MILK_LOW) * (1 - t) + np.float32(MILK_HIGH) * t).astype(np.float32)
+    return colour_map(t).astype(np.float32)
+
+
 __all__ = ["MODES", "DEFAULT_MODE", "COLOUR_MAP", "MILK_LOW", "MILK_HIGH", "ColourScale",
-           "colour_map"]
+           "colour_map", "vertex_colours"]

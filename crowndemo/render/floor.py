@@ -7,6 +7,7 @@ import taichi as ti
 from .camera import Geometry
 
 FLOOR_COLOUR = (0.32, 0.34, 0.38)
+SURFACE_FLOOR = (0.11, 0.11, 0.125)     # a dark dish under the milk (the surface's look)
 
 
 class FloorMesh:
@@ -31,4 +32,4 @@ class FloorMesh:
                    two_sided=True)
 
 
-__all__ = ["FloorMesh", "FLOOR_COLOUR"]
+__all__ = ["FloorMesh", "FLOOR_COLOUR", "SURFACE_FLOOR"]

@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Callable, Optional, Tuple
 from .captions import LANGS
 from .colours import DEFAULT_MODE, MODES
 from .renderer import BOOTH_RESOLUTION, DEFAULT_RESOLUTION
-from .view import RenderSettings
+from .view import DEFAULT_STYLE, STYLES, RenderSettings, default_colour
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -57,12 +57,19 @@ def bounded(lo: float, hi: float, unit: str) -> Callable[[str], float]:
 
 def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
                        recording: bool = True) -> None:
-    """--colour, --lang, --resolution/--booth, --orbit and (``recording``) --fps, --no-video
-    and --no-render. ``lang=False`` leaves --lang to a command that already has it."""
+    """--colour, --lang, --resolution/--booth, --orbit and (``recording``) --style, --fps,
+    --no-video and --no-render. ``lang=False`` leaves --lang to a command that already has
+    it. Without ``recording`` (live) the particles are drawn as spheres."""
     g = parser.add_argument_group("rendering options")
-    g.add_argument("--colour", "--color", dest="colour", choices=MODES, default=DEFAULT_MODE,
-                   help=f"what the particle colour shows; milk is a white look (default: "
-                        f"{DEFAULT_MODE})")
+    if recording:
+        g.add_argument("--style", choices=STYLES, default=DEFAULT_STYLE,
+                       help="surface: the liquid's surface reconstructed from the particles "
+                            "(splashsurf), a milk-white sheet seen from low; particles: each "
+                            f"particle a lit sphere (default: {DEFAULT_STYLE})")
+    g.add_argument("--colour", "--color", dest="colour", choices=MODES, default=None,
+                   help="what the colour shows; milk is a white look (default: "
+                        + (f"{default_colour('surface')} on the surface, " if recording else "")
+                        + f"{DEFAULT_MODE} on spheres)")
     if lang:
         g.add_argument("--lang", choices=LANGS, default="en",
                        help="caption language; ja needs a CJK font (default: en)")
@@ -90,11 +97,21 @@ def add_render_options(parser: argparse.ArgumentParser, lang: bool = True,
                        help="render nothing (no frames, no video; needs no Vulkan)")
 
 
+def style_of(args: argparse.Namespace) -> str:
+    """The drawing style the options ask for (a command without --style draws spheres)."""
+    return getattr(args, "style", "particles")
+
+
+def colour_of(args: argparse.Namespace) -> str:
+    """The colour field the options ask for: --colour, else the style's default."""
+    return args.colour or default_colour(style_of(args))
+
+
 def settings_from_args(args: argparse.Namespace) -> RenderSettings:
     fps = getattr(args, "fps", RenderSettings.fps)
-    return RenderSettings(colour=args.colour, lang=getattr(args, "lang", "en") or "en",
+    return RenderSettings(colour=colour_of(args), lang=getattr(args, "lang", "en") or "en",
                           resolution=tuple(args.resolution), orbit=args.orbit,
-                          video=getattr(args, "video", True), fps=fps)
+                          video=getattr(args, "video", True), fps=fps, style=style_of(args))
 
 
 def sink_from_args(args: argparse.Namespace, resolved: Resolved, out_dir: str,
@@ -113,5 +130,5 @@ def sink_from_args(args: argparse.Namespace, resolved: Resolved, out_dir: str,
                      resume=resume)
 
 
-__all__ = ["add_render_options", "settings_from_args", "sink_from_args", "parse_resolution",
+__all__ = ["add_render_options", "settings_from_args", "style_of", "colour_of", "sink_from_args", "parse_resolution",
            "bounded", "FPS_RANGE", "ORBIT_RANGE"]

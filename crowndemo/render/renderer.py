@@ -1,9 +1,11 @@
 """The GGUI renderer: one window (offscreen unless shown), particles as lit spheres with
-per-vertex colours, an optional floor mesh, and a capture of each frame as an RGB image."""
+per-vertex colours or the liquid surface as a two-sided mesh (the milk look: a dark ground, a
+key light from behind and to the side, low ambient), an optional floor mesh, and a capture of
+each frame as an RGB image."""
 from __future__ import annotations
 
 import math
-from typing import Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Tuple
 
 import numpy as np
 
@@ -12,13 +14,25 @@ from .buffers import ParticleBuffers
 from .camera import Pose
 from .colours import ColourScale
 from .floor import FloorMesh
+from .meshbuffers import MeshBuffers
 from .window import close_window, open_window
+
+if TYPE_CHECKING:
+    from .surface import SurfaceMesh
 
 BACKGROUND = (0.07, 0.08, 0.10)
 AMBIENT = (0.35, 0.35, 0.35)
 LIGHT = (0.75, 0.75, 0.75)
 DEFAULT_RESOLUTION = (1280, 720)
 BOOTH_RESOLUTION = (1920, 1080)
+# the surface's look (GGUI shades ambient + diffuse, no specular): dark ground, low ambient so
+# the sheet has shape, a key light behind the crown and to the side (the rim and jets catch
+# it), a weak fill from the camera's side
+SURFACE_BACKGROUND = (0.015, 0.017, 0.022)
+SURFACE_AMBIENT = (0.16, 0.16, 0.16)
+KEY_LIGHT = (0.95, 0.93, 0.88)
+FILL_LIGHT = (0.30, 0.31, 0.34)
+KEY_TURN, KEY_RISE = 125.0, 40.0      # key light: degrees from the eye about the axis, above
 
 
 class Renderer:
@@ -35,16 +49,15 @@ class Renderer:
         self.camera = ti.ui.Camera()
         self.background = tuple(background)
         self.buffers: Optional[ParticleBuffers] = None
-        self.drawn = 0                       # particles drawn in the last frame
+        self.mesh_buffers: Optional[MeshBuffers] = None
+        self.drawn = 0                       # particles (triangles) drawn in the last frame
 
     def _buffers_for(self, capacity: int) -> ParticleBuffers:
         if self.buffers is None or self.buffers.capacity < capacity:
             self.buffers = ParticleBuffers(capacity)
         return self.buffers
 
-    def draw(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
-             floor: Optional[FloorMesh] = None) -> None:
-        """Submit one frame: the fluid of ``state`` as spheres of world ``radius``."""
+    def _set_camera(self, pose: Pose) -> float:
         cam, scene = self.camera, self.scene
         cam.position(*pose.eye)
         cam.lookat(*pose.target)
@@ -54,6 +67,13 @@ class Renderer:
         cam.z_near(dist * 1e-3)
         cam.z_far(dist * 1e2)
         scene.set_camera(cam)
+        return dist
+
+    def draw(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
+             floor: Optional[FloorMesh] = None) -> None:
+        """Submit one frame: the fluid of ``state`` as spheres of world ``radius``."""
+        scene = self.scene
+        dist = self._set_camera(pose)
         scene.ambient_light(AMBIENT)
         eye, target = np.array(pose.eye), np.array(pose.target)
         scene.point_light(tuple(eye + np.array([0.0, 0.0, 0.8 * dist])
@@ -69,6 +89,29 @@ class Renderer:
             scene.particles(buf.pos, radius=radius * h / w, per_vertex_color=buf.colour,
                             index_count=self.drawn)
         self.canvas.set_background_color(self.background)
+        self.canvas.scene(scene)
+
+    def draw_surface(self, mesh: SurfaceMesh, colours: np.ndarray, pose: Pose,
+                     floor: Optional[FloorMesh] = None) -> None:
+        """Submit one frame: ``mesh`` (two-sided, its own normals) with per-vertex
+        ``colours`` (V x 3 in 0..1), lit by the key and fill lights."""
+        scene = self.scene
+        dist = self._set_camera(pose)
+        scene.ambient_light(SURFACE_AMBIENT)
+        for turn, rise, colour in ((KEY_TURN, KEY_RISE, KEY_LIGHT), (-30.0, 20.0, FILL_LIGHT)):
+            scene.point_light(_light_at(pose, dist, turn, rise), colour)
+        if floor is not None:
+            floor.draw(scene)
+        if self.mesh_buffers is None:
+            self.mesh_buffers = MeshBuffers()
+        buf = self.mesh_buffers
+        self.drawn = buf.fill(mesh.vertices, mesh.triangles, mesh.normals, colours) // 3
+        if self.drawn:
+            for offset, count in buf.pieces():
+                scene.mesh(buf.vertices, buf.indices, buf.normals, per_vertex_color=buf.colours,
+                           two_sided=True, vertex_count=buf.n_vertices, index_offset=offset,
+                           index_count=count)
+        self.canvas.set_background_color(SURFACE_BACKGROUND)
         self.canvas.scene(scene)
 
     def capture(self) -> np.ndarray:
@@ -92,4 +135,16 @@ class Renderer:
         self.close()
 
 
-__all__ = ["Renderer", "BACKGROUND", "DEFAULT_RESOLUTION", "BOOTH_RESOLUTION"]
+def _light_at(pose: Pose, dist: float, turn: float, rise: float) -> Tuple[float, ...]:
+    """A light 2 ``dist`` from the target, ``turn`` degrees about the vertical from the eye's
+    side, ``rise`` degrees above the horizontal."""
+    d = np.subtract(pose.eye, pose.target)
+    az = math.atan2(d[1], d[0]) + math.radians(turn)
+    el = math.radians(rise)
+    offset = 2 * dist * np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az),
+                                  math.sin(el)])
+    return tuple(float(v) for v in np.add(pose.target, offset))
+
+
+__all__ = ["Renderer", "BACKGROUND", "DEFAULT_RESOLUTION", "BOOTH_RESOLUTION",
+           "SURFACE_BACKGROUND"]

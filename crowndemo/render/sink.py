@@ -4,8 +4,9 @@ complete gets ``video.partial.mp4`` and ``preview.partial.gif`` instead, so a pa
 never stands as complete; so does one whose encoding failed (``close`` then raises). Every
 file is written under a temporary name and renamed.
 
-It times itself: ``frame_seconds`` (render, caption and PNG of each frame), ``render_seconds``
-(their sum) and ``encode_seconds``, to set against the simulation's time per frame.
+It times itself: ``frame_seconds`` (surface, render, caption and PNG of each frame),
+``render_seconds`` (their sum), ``surface_seconds`` (the surface reconstruction's part of it)
+and ``encode_seconds``, to set against the simulation's time per frame.
 """
 from __future__ import annotations
 
@@ -43,6 +44,7 @@ class FrameSink:
             raise ValueError(f"renderer of {self.renderer.resolution} for frames of "
                              f"{self.settings.resolution}")
         self.frame_seconds: List[float] = []
+        self.surface_frame_seconds: List[float] = []
         self.encode_seconds = 0.0
         self.paths: List[str] = []
         self.outputs: Dict[str, str] = {}          # what close() wrote: video, preview
@@ -57,7 +59,9 @@ class FrameSink:
         if self.status is not None:
             raise RuntimeError("the frame sink is closed")
         start = _time.perf_counter()
+        self.view.surface_seconds = 0.0
         image = self.view.image(self.renderer, sim.state, time, index)
+        self.surface_frame_seconds.append(self.view.surface_seconds)
         path = os.path.join(self.frames_dir, frame_name(index, ".png"))
         video.write_png(image, path)
         self.paths.append(path)
@@ -111,8 +115,13 @@ class FrameSink:
 
     def timing(self) -> Dict[str, float]:
         n = len(self.frame_seconds)
-        return {"frames": n, "render_seconds": self.render_seconds,
+        surface = sum(self.surface_frame_seconds)
+        return {"frames": n, "style": self.settings.style,
+                "render_seconds": self.render_seconds,
                 "render_seconds_per_frame": self.render_seconds / n if n else 0.0,
+                "surface_seconds": surface,
+                "surface_seconds_per_frame": surface / n if n else 0.0,
+                "surface_triangles_last": self.view.triangles,
                 "encode_seconds": self.encode_seconds}
 
 

@@ -80,6 +80,17 @@ def limit_threads(threads: int) -> None:
     os.environ.setdefault("RAYON_NUM_THREADS", str(max(int(threads), 1)))
 
 
+def fluid_of(state) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
+    """The fluid particles of a ParticleState as numpy: positions and the colour fields
+    (speed, pressure) a surface carries (walls, dummies, mirror images and parked left out)."""
+    from ..core.state import FLUID
+    n = int(state.n[None])
+    keep = state.kind.to_numpy()[:n] == FLUID
+    vel = state.vel.to_numpy()[:n][keep]
+    return state.pos.to_numpy()[:n][keep], {
+        "speed": np.linalg.norm(vel, axis=1), "pressure": state.pressure.to_numpy()[:n][keep]}
+
+
 def _lift(pos: np.ndarray, l0: float) -> Tuple[np.ndarray, int]:
     """(N, 3) positions: 3D as given; a 2D slice (x, z) extruded into SLICE_LAYERS along y.
     Returns the positions and how many copies of each particle were made."""
@@ -196,5 +207,5 @@ def _weld_planes(mesh: SurfaceMesh, axes: Tuple[int, ...]) -> SurfaceMesh:
                    fields={k: f[keep] for k, f in mesh.fields.items()})
 
 
-__all__ = ["SurfaceParams", "SurfaceMesh", "reconstruct", "mirror", "plane_axes",
+__all__ = ["SurfaceParams", "SurfaceMesh", "reconstruct", "fluid_of", "mirror", "plane_axes",
            "limit_threads", "AXES", "SLICE_LAYERS"]

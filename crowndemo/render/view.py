@@ -1,17 +1,19 @@
-"""How a preset is shown: its camera (with the optional orbit), colour scale, sphere size,
-floor and caption, from the resolved preset and the render settings. ``image`` renders one
-captioned frame of a particle state."""
+"""How a preset is shown: its style (the liquid surface or spheres), camera (with the optional
+orbit), colour scale, sphere size, floor and caption, from the resolved preset and the render
+settings. ``image`` renders one captioned frame of a particle state."""
 from __future__ import annotations
 
+import time as _time
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Sequence, Tuple
 
 import numpy as np
 
 from . import camera
 from .captions import CaptionInfo, draw_caption
-from .colours import DEFAULT_MODE, ColourScale
+from .colours import DEFAULT_MODE, ColourScale, vertex_colours
 from .renderer import DEFAULT_RESOLUTION
+from .surface import SurfaceMesh, SurfaceParams, fluid_of, reconstruct
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -20,16 +22,37 @@ if TYPE_CHECKING:
     from .renderer import Renderer
 
 SPHERE = 0.5        # drawn sphere radius / l0: neighbouring particles touch
+STYLES = ("surface", "particles")
+DEFAULT_STYLE = "surface"
+SURFACE_COLOUR = "milk"          # the surface's default colour field; spheres: DEFAULT_MODE
+SURFACE_ELEVATION = 18.0         # degrees above the film: low, as the crown is photographed
+SYMMETRY_PLANES = {"full": [], "half": ["x"], "quarter": ["x", "y"]}
+
+
+def default_colour(style: str) -> str:
+    return SURFACE_COLOUR if style == "surface" else DEFAULT_MODE
+
+
+def planes_of(resolved: Resolved) -> Sequence[str]:
+    """The symmetry planes of a preset's run (axis names; none when it has no such key)."""
+    return SYMMETRY_PLANES[resolved.scene.get("symmetry", "full") or "full"]
 
 
 @dataclass(frozen=True)
 class RenderSettings:
-    colour: str = DEFAULT_MODE
+    colour: Optional[str] = None         # None: the style's (milk on the surface, else speed)
     lang: str = "en"
     resolution: Tuple[int, int] = DEFAULT_RESOLUTION
     orbit: float = 0.0           # degrees the camera turns per frame (0: fixed)
     video: bool = True           # encode video.mp4 and preview.gif when a recording closes
     fps: float = 12.0            # frames per second of the video
+    style: str = DEFAULT_STYLE   # surface (the liquid, reconstructed) or particles (spheres)
+
+    def __post_init__(self):
+        if self.style not in STYLES:
+            raise ValueError(f"style {self.style!r} is not one of {', '.join(STYLES)}")
+        if self.colour is None:
+            object.__setattr__(self, "colour", default_colour(self.style))
 
 
 @dataclass
@@ -39,10 +62,16 @@ class PresetView:
     scale: ColourScale
     settings: RenderSettings = field(default_factory=RenderSettings)
     marker: Optional[str] = None          # a label in the corner of every frame
+    planes: Sequence[str] = ()            # the run's symmetry planes: the surface is mirrored
+    surface_params: Optional[SurfaceParams] = None     # None: SurfaceParams()
 
     def __post_init__(self):
-        self.start = camera.frame(self.geometry, self.settings.resolution)
+        low = self.settings.style == "surface" and self.geometry.dim == 3
+        self.start = camera.frame(self.geometry, self.settings.resolution,
+                                  elevation=SURFACE_ELEVATION if low else None)
         self._floor = None
+        self.surface_seconds = 0.0            # the last frame's reconstruction, wall seconds
+        self.triangles = 0                    # the last frame's surface triangles
 
     @classmethod
     def from_resolved(cls, resolved: Resolved, settings: RenderSettings = RenderSettings()
@@ -50,7 +79,8 @@ class PresetView:
         geometry = camera.Geometry.from_resolved(resolved)
         scale = ColourScale.for_scene(settings.colour, resolved.speed, geometry.film,
                                       geometry.drop, resolved.liquid["rho"])
-        return cls(geometry, CaptionInfo.from_resolved(resolved), scale, settings)
+        return cls(geometry, CaptionInfo.from_resolved(resolved), scale, settings,
+                   planes=planes_of(resolved))
 
     @property
     def radius(self) -> float:
@@ -62,17 +92,41 @@ class PresetView:
     @property
     def floor(self) -> FloorMesh:
         if self._floor is None:                     # Taichi fields: made on first use
-            from .floor import FloorMesh
-            self._floor = FloorMesh(self.geometry)
+            from .floor import FloorMesh, SURFACE_FLOOR
+            surface = self.settings.style == "surface"
+            self._floor = (FloorMesh(self.geometry, SURFACE_FLOOR) if surface
+                           else FloorMesh(self.geometry))
         return self._floor
 
     def image(self, renderer: Renderer, state: ParticleState, time: float, index: int = 0,
               pose: Optional[camera.Pose] = None) -> np.ndarray:
         """One captioned frame (h, w, 3 uint8) of ``state`` at simulated ``time``."""
-        img = renderer.render(state, pose or self.pose(index), self.scale, self.radius,
-                              self.floor)
+        pose = pose or self.pose(index)
+        if self.settings.style == "surface":
+            pos, fields = fluid_of(state)
+            img = self.surface_image(renderer, pos, fields, pose)
+        else:
+            img = renderer.render(state, pose, self.scale, self.radius, self.floor)
         return draw_caption(img, self.caption, time, self.settings.lang, self.marker,
                             self.scale)
 
+    def surface(self, pos: np.ndarray, fields: dict) -> SurfaceMesh:
+        """The liquid surface of fluid particles (timed: ``surface_seconds``)."""
+        start = _time.perf_counter()
+        mesh = reconstruct(pos, self.geometry.l0, fields, self.surface_params or SurfaceParams(),
+                           planes=self.planes)
+        self.surface_seconds = _time.perf_counter() - start
+        self.triangles = mesh.n_triangles
+        return mesh
 
-__all__ = ["RenderSettings", "PresetView", "SPHERE"]
+    def surface_image(self, renderer: Renderer, pos: np.ndarray, fields: dict,
+                      pose: camera.Pose) -> np.ndarray:
+        """The uncaptioned frame of the surface of fluid particles ``pos`` with ``fields``."""
+        mesh = self.surface(pos, fields)
+        colours = vertex_colours(self.scale, mesh.vertices[:, 2], mesh.fields)
+        renderer.draw_surface(mesh, colours, pose, self.floor)
+        return renderer.capture()
+
+
+__all__ = ["RenderSettings", "PresetView", "SPHERE", "STYLES", "DEFAULT_STYLE",
+           "default_colour", "planes_of"]

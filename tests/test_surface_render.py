@@ -1,0 +1,137 @@
+"""The liquid surface drawn by GGUI (offscreen, lavapipe): the mesh fields, the milk look, and
+a recording of ``quick`` in the surface style."""
+import json
+
+import numpy as np
+import pytest
+
+pytest.importorskip("pysplashsurf")
+
+from crowndemo import config  # noqa: E402
+from crowndemo.cli import main  # noqa: E402
+from crowndemo.record import snapshots  # noqa: E402
+from crowndemo.render import camera, window  # noqa: E402
+from crowndemo.render.colours import MILK_HIGH, MILK_LOW  # noqa: E402
+from crowndemo.render.meshbuffers import HEADROOM, MAX_INDICES, MeshBuffers  # noqa: E402
+from crowndemo.render.renderer import SURFACE_BACKGROUND, Renderer  # noqa: E402
+from crowndemo.render.surface import reconstruct  # noqa: E402
+from crowndemo.render.video import read_image, read_video  # noqa: E402
+from crowndemo.render.view import PresetView, RenderSettings  # noqa: E402
+
+RES = (320, 180)
+L0 = 1.0e-4
+MILK = np.array([MILK_LOW, MILK_HIGH]).mean(axis=0)
+
+
+def chroma(rgb):
+    """Colour without brightness: rgb / its sum."""
+    rgb = np.asarray(rgb, float)
+    return rgb / np.maximum(rgb.sum(axis=-1, keepdims=True), 1e-9)
+
+
+def milk_share(img, bright):
+    """Share of the ``bright`` pixels whose colour is the milk's, shaded by white lights
+    (the lights' tints differ from white by at most 0.05 in chroma)."""
+    d = np.abs(chroma(img[bright]) - chroma(MILK)).max(axis=1)
+    return (d < 0.02).mean()
+
+
+def ball(radius, centre):
+    n = int(radius) + 1
+    g = (np.stack(np.meshgrid(*[np.arange(-n, n) + 0.5] * 3, indexing="ij"), -1)
+         .reshape(-1, 3))
+    return g[np.linalg.norm(g, axis=1) <= radius] * L0 + np.asarray(centre)
+
+
+@pytest.fixture
+def renderer():             # closed after its test: the recording below opens its own window
+    window.check_available()
+    r = Renderer(RES)
+    yield r
+    r.close()
+
+
+def test_ball_drawn_in_milk_where_it_projects(renderer):
+    """A ball of R = 10 l0 seen from 6 R: its pixels lie on its projected disc and are milk;
+    the ground is the surface background."""
+    centre = (0.0, 0.0, 12 * L0)
+    mesh = reconstruct(ball(10, centre), L0)
+    pose = camera.spherical(centre, 60 * L0, -60.0, 18.0, 35.0)
+    colours = np.tile(np.float32(MILK), (mesh.n_vertices, 1))
+    renderer.draw_surface(mesh, colours, pose)
+    img = renderer.capture().astype(float) / 255
+    bg = np.abs(img - np.array(SURFACE_BACKGROUND)).max(axis=2) < 2 / 255
+    cx, cy, _ = camera.project(pose, [centre], RES)[0]
+    r_px = camera.pixel_radius(pose, centre, 10 * L0, RES)
+    rows, cols = np.mgrid[:RES[1], :RES[0]]
+    dist = np.hypot(cols + 0.5 - cx, rows + 0.5 - cy)
+    assert bg[dist > r_px + 2].all()                  # nothing outside the sphere's outline
+    inside = dist < r_px - 2
+    assert not bg[inside].any()                        # the whole disc is drawn
+    assert milk_share(img, inside) > 0.95
+
+
+def test_mesh_fields_have_headroom_and_grow_rarely():
+    """Fields made for a mesh hold it with HEADROOM; meshes that grow by 10 % a frame are
+    reallocated only when they pass the headroom (a ball of R^2 area: 10 frames, 3 times)."""
+    window.check_available()
+    buf = MeshBuffers()
+    sizes = [int(1000 * 1.1 ** k) for k in range(10)]
+    for n in sizes:
+        v = np.zeros((n, 3), np.float32)
+        buf.fill(v, np.zeros((2 * n, 3), np.int64), v, v)
+        assert buf.vertex_capacity >= n and buf.index_capacity >= 6 * n
+        assert buf.vertex_capacity <= HEADROOM * max(sizes)
+    expected = 1 + int(np.log(sizes[-1] / sizes[0]) / np.log(HEADROOM))
+    assert buf.allocations <= expected + 1
+    assert buf.allocations < len(sizes) / 2
+    buf.n_indices = 2 * MAX_INDICES + 9                # the pieces a huge mesh is drawn in
+    pieces = list(buf.pieces())
+    assert pieces == [(0, MAX_INDICES), (MAX_INDICES, MAX_INDICES), (2 * MAX_INDICES, 9)]
+    assert all(float(np.float32(x)) == x for piece in pieces for x in piece)   # exact in f32
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    """quick (draft) to 0.5 ms in the surface style, its frames and snapshots."""
+    root = tmp_path_factory.mktemp("rec")
+    sets = ["scene.t_end=5e-4"]
+    args = ["record", "quick", "--recordings", str(root), "--resolution", "%dx%d" % RES,
+            "--quiet", "--fast-compile"] + sum((["--set", s] for s in sets), [])
+    assert main(args) == 0
+    return root / "quick", config.load("quick", "draft", sets)
+
+
+def test_quick_surface_frames(quick):
+    folder, r = quick
+    meta = json.loads((folder / "metadata.json").read_text())
+    frames = sorted((folder / "frames").glob("frame_*.png"))
+    assert len(frames) == len(r.frame_times()) + 1 == len(meta["frames"])
+    assert len(list(read_video(str(folder / "video.mp4")))) == len(frames)
+    images = [read_image(str(f)).astype(float) / 255 for f in frames]
+    view = PresetView.from_resolved(r, RenderSettings(resolution=RES))
+    caption = 0.2                              # the caption band's share of the height, top
+    for img in images:
+        body = img[int(caption * RES[1]):]
+        bright = body.max(axis=2) > 2 * max(0.125, max(SURFACE_BACKGROUND))  # over the dish
+        assert bright.mean() > 0.1                                       # not blank
+        assert milk_share(body, bright) > 0.9                           # milk, mostly
+    for a, b in zip(images, images[1:]):
+        assert np.abs(a - b).max() > 0.2                                 # it moves
+    # the crown at the end time: the liquid above the film, projected with the frame's camera,
+    # lies inside the picture and spans a good part of the box the camera frames (the crown's
+    # reach, 1.3 Yarin-Weiss base radii: the crown itself is at least half of it)
+    snap = snapshots.read(folder / meta["frames"][-1]["file"])
+    mesh = reconstruct(snap["pos"], r.l0)
+    above = mesh.vertices[mesh.vertices[:, 2] > r.scene["film"] + r.l0]
+    pose = view.pose(len(frames) - 1)
+    px = camera.project(pose, above, RES)
+    assert (px[:, 0] > 0).all() and (px[:, 0] < RES[0]).all()
+    assert (px[:, 1] > 0).all() and (px[:, 1] < RES[1]).all()
+    lo, hi = view.geometry.frame_box()
+    box = camera.project(pose, [[lo[0], 0, 0], [hi[0], 0, 0]], RES)
+    assert np.ptp(px[:, 0]) > 0.5 * np.ptp(box[:, 0])
+    # the surface's cost, beside the render's and the simulation's
+    t = meta["render"]
+    assert t["style"] == "surface" and 0 < t["surface_seconds"] < t["render_seconds"]
+    assert t["surface_seconds_per_frame"] == pytest.approx(t["surface_seconds"] / len(frames))
