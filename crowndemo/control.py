@@ -12,7 +12,7 @@ import math
 from typing import TYPE_CHECKING, Dict, List
 
 from .core.params import Model
-from .core.step import Simulator, max_particles
+from .core.step import Simulator, capacity_for, max_particles
 
 if TYPE_CHECKING:
     from .scenes.base import Scene
@@ -41,7 +41,7 @@ class Session:
     def load(self, scene: Scene) -> Simulator:
         """A simulator for ``scene``'s model, configured with its values and loaded with it."""
         model = Model.of(scene.physics, scene.numerics)
-        n = len(scene.pos)
+        n = capacity_for(scene)         # the particles, and room for any mirror images
         sim = self._sims.get(model)
         if sim is None:
             sim = self._build(scene, n)

@@ -114,10 +114,10 @@ class CellGrid:
         d = ti.static(self.dim)
         pos, kind = ti.static(self.state.pos, self.state.kind)
         # bounds of the live particles, by blocks (blocks.py: no contended atomics)
-        for b in range(blocks_for(self.state.n[None])):
+        for b in range(blocks_for(self.state.in_grid())):
             lo = ti.Vector([3.0e38] * d)
             hi = ti.Vector([-3.0e38] * d)
-            for i in range(b * BLOCK, ti.min(self.state.n[None], (b + 1) * BLOCK)):
+            for i in range(b * BLOCK, ti.min(self.state.in_grid(), (b + 1) * BLOCK)):
                 # a non-finite position (a run blowing up, which the health check after the
                 # step reports) must not make the cell side and dimensions garbage
                 if kind[i] != GONE and (ti.abs(pos[i]) < FAR).all():
@@ -125,7 +125,7 @@ class CellGrid:
                     hi = ti.max(hi, pos[i])
             self.block_lo[b] = lo
             self.block_hi[b] = hi
-        blocks = blocks_for(self.state.n[None])
+        blocks = blocks_for(self.state.in_grid())
         reduce_blocks(self.block_lo, blocks, self.group_lo, self.live_lo, smaller, self._far_up)
         reduce_blocks(self.block_hi, blocks, self.group_hi, self.live_hi, larger, self._far_down)
         for _ in range(1):   # serial: cell side and dimensions that fit in max_cells
@@ -164,7 +164,7 @@ class CellGrid:
             c = self.particle_cell[i]
             if c >= 0:
                 self.cell_count[c] = 0
-        for i in range(self.state.n[None]):
+        for i in range(self.state.in_grid()):
             if kind[i] != GONE:
                 c = self.linear(self.cell_of(pos[i]))
                 self.particle_cell[i] = c
@@ -183,14 +183,14 @@ class CellGrid:
         for _ in range(1):
             self.cell_start[cells] = self.n_live[None]
             self.n_parked[None] = 0
-            self.n_counted[None] = self.state.n[None]
+            self.n_counted[None] = self.state.in_grid()
         for b in range(blocks_for(cells)):
             run = self.block_sum[b]
             for c in range(b * BLOCK, ti.min(cells, (b + 1) * BLOCK)):
                 self.cell_start[c] = run
                 run += self.cell_count[c]
         # scatter; parked particles go after the live ones so a permutation keeps them
-        for i in range(self.state.n[None]):
+        for i in range(self.state.in_grid()):
             c = self.particle_cell[i]
             if c >= 0:
                 slot = self.cell_start[c] + self.rank[i]
@@ -201,7 +201,7 @@ class CellGrid:
 
     @ti.kernel
     def _identity_order(self):
-        for k in range(self.state.n[None]):
+        for k in range(self.state.in_grid()):
             self.order[k] = k
 
     @ti.func

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields, replace
-from typing import Any, Optional, TypeVar
+from typing import Any, Optional, Tuple, TypeVar
 
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
@@ -101,6 +101,9 @@ class Numerics:
     # the floor (z = 0): layers of wall and dummy particles, or the analytic plane floor
     # (core/plane_floor.py: their contributions tabulated against the height; no particles)
     wall_model: str = "particles"
+    # mirror symmetry planes through the scene's axis (core/symmetry.py): axes 0 (x = 0) and/or
+    # 1 (y = 0); set by a scene built as one half or quarter (scenes/symmetric.py), () whole
+    mirror_planes: Tuple[int, ...] = ()
 
     def validate(self, source: str = "parameters") -> "Numerics":
         def need(cond: bool, key: str, allowed: str):
@@ -127,6 +130,9 @@ class Numerics:
              and 1 <= self.cells_per_re <= 3, "cells_per_re", "1, 2 or 3")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
              "an integer >= 0 (0: never)")
+        need(isinstance(self.mirror_planes, tuple)
+             and self.mirror_planes in ((), (0,), (1,), (0, 1)), "mirror_planes",
+             "(), (0,), (1,) or (0, 1): the planes x = 0 (0) and y = 0 (1)")
         return self
 
     def free_surface_beta(self, dim: int) -> float:
@@ -146,20 +152,22 @@ class Model:
     cells_per_re: int = 2
     plane_floor: bool = False
     relative_courant: bool = False   # the relative speed measured (terms.py)
+    mirror_planes: Tuple[int, ...] = ()   # symmetry planes (symmetry.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
                    numerics.cells_per_re, numerics.wall_model == "plane",
-                   numerics.courant_speed == "relative")
+                   numerics.courant_speed == "relative", tuple(numerics.mirror_planes))
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
                 "gravity": self.gravity, "pressure_gradient": self.pressure_gradient,
                 "collision": self.collision, "neighbour_list": self.neighbour_list,
                 "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor,
-                "relative_courant": self.relative_courant}
+                "relative_courant": self.relative_courant,
+                "mirror_planes": list(self.mirror_planes)}
 
 
 def _finite(x) -> bool:

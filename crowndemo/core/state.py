@@ -40,6 +40,9 @@ class ParticleState:
     def __init__(self, dim: int, capacity: int):
         self.dim, self.capacity = dim, int(capacity)
         self.n = ti.field(ti.i32, shape=())           # active particles
+        # mirror images of particles near symmetry planes, in slots [n, n + n_images): in the
+        # grid and its walks only (core/symmetry.py); 0 without planes
+        self.n_images = ti.field(ti.i32, shape=())
         self.threads = _cpu_threads()
         self.chunks_per_thread = ti.field(ti.i32, shape=())    # see spread
         self._persistent: Dict[str, ti.Field] = {}
@@ -91,7 +94,13 @@ class ParticleState:
 
     def _set_count(self, n: int) -> None:
         self.n[None] = n
+        self.n_images[None] = 0
         self.chunks_per_thread[None] = n // (SPREAD_CHUNK * self.threads)
+
+    @ti.func
+    def in_grid(self):
+        """Slots the cell grid holds: the particles and their mirror images."""
+        return self.n[None] + self.n_images[None]
 
     @ti.func
     def spread(self, k):

@@ -23,6 +23,7 @@ from .params import Model, Numerics, ParameterError, Physics
 from .plane_floor import PlaneFloor
 from .pressure import Pressure
 from .state import FLUID, ParticleState
+from .symmetry import Symmetry, image_room
 from .terms import CLOSE_SLOTS, Predictor
 
 
@@ -100,6 +101,13 @@ def default_max_cells(particles: int) -> int:
 FIELD_ENTRIES_MAX = 2 ** 31 - 1
 
 
+def capacity_for(scene) -> int:
+    """The particles a simulator must hold for ``scene``: its particles, and room for their
+    mirror images when it has symmetry planes (symmetry.image_room)."""
+    planes = scene.numerics.mirror_planes
+    return len(scene.pos) + image_room(scene.pos, planes, scene.physics.re)
+
+
 def entries_per_particle(model: Model) -> int:
     """The most entries per particle of capacity held by one field of a simulator for
     ``model``: the cell grid's cells (CELLS_PER_PARTICLE), the neighbour list's slots, the
@@ -151,6 +159,9 @@ class Simulator:
         self.predictor = Predictor(self.model, self.grid, self.coef, self.floor)
         self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
         self.health = Health(self.state, self.coef)
+        # mirror images across the symmetry planes (symmetry.py); None for a whole scene
+        self.symmetry = (Symmetry(self.state, self.model.mirror_planes)
+                         if self.model.mirror_planes else None)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0
@@ -180,6 +191,8 @@ class Simulator:
         self.coef.set(physics, numerics, self.lattice, lo, hi)
         if self.floor is not None:
             self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio))
+        if self.symmetry is not None:
+            self.symmetry.configure(self.lattice.re)
 
     def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
         self.state.load(pos, vel, kind)
@@ -223,15 +236,37 @@ class Simulator:
                 self.stage_seconds[name] += now - self._stage_t
             self._stage_t = now
 
+    def _build(self, reorder: bool) -> None:
+        """The cell grid at the current positions (with ``reorder``, the particles permuted into
+        cell order first); with symmetry planes, the mirror images made and gridded too."""
+        re = self.lattice.re
+        sym = self.symmetry
+        if sym is None:
+            self.grid.build(re, reorder=reorder)
+            return
+        sym.clear()                    # the permutation moves particles only, never images
+        if reorder:
+            self.grid.build(re, reorder=True)
+        wanted = sym.make_images()
+        if wanted > sym.room:
+            s = self.stats
+            raise InstabilityError(
+                s.steps, s.time, f"{wanted:,} mirror images are needed near the symmetry "
+                f"planes, room for {sym.room:,}", BINDINGS[s.bound_log[-1]] if s.bound_log
+                else "none", s.dt_log[-1] if s.dt_log else 0.0,
+                "run the whole scene (scene.symmetry: full), or load it into a simulator of "
+                "more capacity (symmetry.image_room)")
+        self.grid.build(re, reorder=False)
+
     def step(self, dt_cap: float = math.inf) -> float:
         """Advance one step; returns dt. Raises InstabilityError on a broken health limit."""
         t_first = _time.perf_counter() if self.stats.steps == 0 else None
-        re = self.lattice.re
         k = self.stats.steps
         reorder = self.numerics.reorder_every > 0 and k % self.numerics.reorder_every == 0
+        sym = self.symmetry
         self._stage(None)
         if self.predictor.needs_neighbours:
-            self.grid.build(re, reorder=reorder)        # neighbours at r^k
+            self._build(reorder)                        # neighbours at r^k
             self._stage("grid")
         self.predictor.forces()                         # S14 at r^k
         relative = None                                 # the relative Courant limit's speed
@@ -241,12 +276,19 @@ class Simulator:
                                       self._last.max_speed, relative)
         if dt_cap < dt:
             dt, binding = dt_cap, "frame"
-        self.predictor.run(dt, mark=self._stage)        # S15-S16
-        self.grid.build(re, reorder=reorder and not self.predictor.needs_neighbours)  # at r*
+        self.predictor.run(dt, mark=self._stage,        # S15-S16
+                           sync=sym.sync_velocity if sym is not None else None)
+        if sym is not None:
+            sym.reflect()                               # nothing crosses a plane
+        self._build(reorder and not self.predictor.needs_neighbours)  # at r*
         self._stage("grid")
         self.pressure.density_and_pressure()            # S17 (M3)
+        if sym is not None:
+            sym.sync_pressure()                         # images' P_j for the corrector
         self._stage("density")
         self.pressure.correct(dt)                       # S18-S20
+        if sym is not None:
+            sym.reflect()
         self._stage("corrector")
         s = self.stats
         s.steps += 1
@@ -307,7 +349,7 @@ class Simulator:
     # ---- output --------------------------------------------------------------------------
     def refresh_pressure(self) -> None:
         """P^{k+1} from n^{k+1} at the current positions (S21), for output only."""
-        self.grid.build(self.lattice.re, reorder=False)
+        self._build(reorder=False)
         self.pressure.density_and_pressure()
 
     def snapshot(self) -> Dict[str, np.ndarray]:
@@ -319,4 +361,5 @@ class Simulator:
     def memory_bytes(self) -> int:
         return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
                 + self.predictor.nbytes() + self.pressure.nbytes()
-                + (self.floor.nbytes() if self.floor else 0))
+                + (self.floor.nbytes() if self.floor else 0)
+                + (self.symmetry.nbytes() if self.symmetry else 0))

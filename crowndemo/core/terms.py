@@ -146,11 +146,15 @@ class Predictor:
                     acc.st += surface_tension_pair(rij, r, self.coef.l0[None],
                                                    self.coef.re[None])
 
-    def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None) -> None:
+    def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None,
+            sync: Optional[Callable[[], None]] = None) -> None:
         """u* = u + dt a* (S15), a* from ``forces`` (which must have run at these positions),
         the collision model on u* at r^k, r* = r + dt u* (S16). ``mark(stage)`` is called as
-        the "predictor" and "collision" stages end (the simulator's stage timer)."""
+        the "predictor" and "collision" stages end (the simulator's stage timer); ``sync()``
+        right after u*, before the collision pass reads the neighbours' u* (symmetry.py)."""
         self.accelerate(dt)
+        if sync is not None and self.model.collision:
+            sync()
         mark("predictor")
         if self.model.collision:
             self.collide()

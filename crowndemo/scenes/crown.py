@@ -13,8 +13,9 @@ from typing import Optional
 
 import numpy as np
 
-from ..core.params import GRAVITY, WATER, Numerics, Physics
+from ..core.params import GRAVITY, WATER, Numerics, Physics, with_values
 from ..core.lattice import wall_layers
+from ..core.symmetry import fraction, plane_names, planes_of
 from .base import Scene, assemble, container_walls, floor_face, lattice_block, particle_faces
 
 
@@ -38,9 +39,14 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
           speed: float = 8.0, gap: float = 1.0e-3, floor: float = 0.09, t_end: float = 4.0e-3,
           trim: bool = True, numerics: Optional[Numerics] = None, rho: float = WATER["rho"],
           nu: float = WATER["nu"], sigma: float = WATER["sigma"], gravity: float = GRAVITY,
-          sound_speed: Optional[float] = None, re_ratio: float = 2.1) -> Scene:
+          sound_speed: Optional[float] = None, re_ratio: float = 2.1,
+          symmetry: str = "full") -> Scene:
     """Drop on a film. ``floor`` is the side of the square container floor (the width of the
-    slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0."""
+    slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0.
+    ``symmetry``: the whole scene (full), or the part x > 0 (half), or x > 0, y > 0 (quarter,
+    3D) with mirror planes through the axis (core/symmetry.py); the lattice then lies at
+    (k + 1/2) l0 from the planes, so that its mirror images continue it."""
+    planes = planes_of(symmetry, dim)
     physics = Physics(dim=dim, l0=l0, v_max=speed, re_ratio=re_ratio, rho=rho, nu=nu,
                       sigma=sigma, gravity=gravity, sound_speed=sound_speed)
     half = floor / 2.0
@@ -48,13 +54,15 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     trimmed = trim and reach < half
     extent = reach if trimmed else half
     # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D)
-    film_pts = lattice_block([-extent] * (dim - 1) + [0.0], [extent] * (dim - 1) + [film], l0)
+    # on a plane's axis the lattice starts at the plane (0) instead of -extent
+    side = lambda lo: [0.0 if a in planes else lo for a in range(dim - 1)]
+    film_pts = lattice_block(side(-extent) + [0.0], [extent] * (dim - 1) + [film], l0)
     if trimmed and dim == 3:
         film_pts = film_pts[np.linalg.norm(film_pts[:, :2], axis=1) <= extent]
     # the drop: lattice points inside the sphere (disc), its bottom `gap` above the film
     radius = drop / 2.0
     centre_z = film + gap + radius
-    box = lattice_block([-radius] * (dim - 1) + [centre_z - radius],
+    box = lattice_block(side(-radius) + [centre_z - radius],
                         [radius] * (dim - 1) + [centre_z + radius], l0)
     rel = box - np.array([0.0] * (dim - 1) + [centre_z])
     drop_pts = box[np.linalg.norm(rel, axis=1) <= radius]
@@ -66,9 +74,11 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     faces = [floor_face(dim)]
     if not trimmed:
         faces += ["x-", "x+"] + (["y-", "y+"] if dim == 3 else [])
+    beyond_planes = {f"{'xy'[a]}-" for a in planes}     # the mirrored side has no wall
+    faces = [f for f in faces if f not in beyond_planes]
     faces = particle_faces(faces, dim, numerics)
     wall_top = film + 0.5 * drop
-    floor_lo = [-extent - (0 if not trimmed else layers * l0)] * (dim - 1) + [0.0]
+    floor_lo = side(-extent - (0 if not trimmed else layers * l0)) + [0.0]
     floor_hi = [extent + (0 if not trimmed else layers * l0)] * (dim - 1) + [wall_top]
     walls = container_walls(floor_lo, floor_hi, l0, layers, faces) if faces else None
     if walls is not None and trimmed and dim == 3:   # the disc under the film, a rim `layers` wide
@@ -91,6 +101,12 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
         left_out.append("viscosity term (nu = 0)")
     info = {"scene": "crown", "film_m": film, "drop_m": drop, "speed_m_s": speed, "gap_m": gap,
             "floor_m": floor, "extent_m": extent, "trimmed": trimmed, "walls": faces,
-            "n_film": int(len(film_pts)), "n_drop": int(len(drop_pts)), "left_out": left_out}
-    return assemble("crown", physics, numerics or Numerics(), fluid, vel, walls, domain, t_end,
-                    info)
+            "n_film": int(len(film_pts)), "n_drop": int(len(drop_pts)), "left_out": left_out,
+            "symmetry": symmetry, "symmetry_planes": plane_names(planes),
+            "simulated_fraction": fraction(planes)}
+    if planes:
+        across = " and ".join(f"{a} = 0" for a in plane_names(planes))
+        left_out.append(f"the mirror images across {across}: one {symmetry} of the scene is "
+                        "simulated (counts are of that part)")
+    numerics = with_values(numerics or Numerics(), mirror_planes=planes)
+    return assemble("crown", physics, numerics, fluid, vel, walls, domain, t_end, info)
