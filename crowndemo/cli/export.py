@@ -1,4 +1,5 @@
-"""``crowndemo export``: a recording as ParaView files (.vtp per frame + a .pvd series)."""
+"""``crowndemo export``: a recording as ParaView files (.vtp per frame + a .pvd series), and
+with --surface the liquid surface's meshes too."""
 from __future__ import annotations
 
 import sys
@@ -15,6 +16,7 @@ examples:
   crowndemo export quick                           # recordings/quick -> recordings/quick/vtk/
   crowndemo export 3m-drop --out /tmp/crown        # somewhere else
   crowndemo export quick --recordings runs         # from runs/quick
+  crowndemo export quick --surface                 # + the liquid surface, for ParaView/Blender
 
 Reads RECORDINGS/PRESET (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
 ./recordings): the frames listed in its metadata.json. When there is no recording, the
@@ -25,8 +27,11 @@ exports the frames it has and says how to resume it.
 Writes, in the one format (VTK; --vtk is the default and may be left out),
 OUT/frame_NNNNN.vtp (XML PolyData, one vertex per particle, raw binary data; point
 data: velocity, pressure, number_density, kind, id; 2D runs get z = 0) and OUT/PRESET.pvd
-(every frame with its time in s): open the .pvd in ParaView. frame_*.vtp files in OUT that
-are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk. All or
+(every frame with its time in s): open the .pvd in ParaView. With --surface, also
+OUT/surface_NNNNN.vtp (the liquid surface reconstructed from the fluid particles with
+splashsurf, as the frames draw it: triangles with point data Normals, speed, pressure,
+height; a run with symmetry planes mirrored into the whole) and OUT/PRESET-surface.pvd.
+frame_*.vtp (and surface_*.vtp) files in OUT that are not part of this export are removed. Default OUT: RECORDINGS/PRESET/vtk. All or
 nothing: a snapshot that cannot be read (truncated, overwritten) is named in an error and
 OUT is left as it was.
 With --quality or --set, an existing recording must have been made with the same values.
@@ -100,6 +105,8 @@ def _export(args) -> int:
     if not files:
         raise UsageError(f"{folder}: the recording has no frame yet")
     pvd = _write_vtk(files, out, r.name)
+    if args.surface:
+        _write_surface(files, out, r, meta)
     state = "" if meta["complete"] else f" (the recording is {meta.get('status')})"
     if meta.get("status") == INTERRUPTED:
         state += (f"; '{PROG} record {r.name} --resume', with the same --quality, --set and "
@@ -129,15 +136,35 @@ def _write_vtk(files, out: Path, name: str) -> Path:
     return pvd
 
 
+def _write_surface(files, out: Path, r, meta: dict) -> Path:
+    """surface_vtk.export with the recording's symmetry planes; UsageError naming a damaged
+    snapshot; says what the reconstruction cost."""
+    from ..record import surface_vtk
+    from ..record.snapshots import SnapshotError
+
+    try:
+        pvd, seconds = surface_vtk.export(files, out, r.name, r.l0, surface_vtk.planes_of(meta))
+    except SnapshotError as e:
+        raise UsageError(f"{e}; the surface was not exported; allowed: the snapshots of a "
+                         f"whole recording: record it again") from None
+    print(f"{PROG}: the liquid surface of {len(files)} frames, {seconds:.2f} s a frame, to "
+          f"{pvd}", file=sys.stderr)
+    return pvd
+
+
 def register(sub, common) -> None:
     p = sub.add_parser("export", parents=common, formatter_class=Fmt, epilog=EXPORT_EPILOG,
-                       help="write a recording as ParaView files (.vtp per frame + .pvd)",
+                       help="write a recording as ParaView files (.vtp per frame + .pvd; "
+                            "--surface: the liquid's meshes too)",
                        description="Export a recording's frames for ParaView; records the "
                                    "preset first when there is no recording.")
     p.add_argument("preset", metavar="PRESET", help=PRESET_HELP)
     p.add_argument("--vtk", action="store_true",
                    help="VTK XML: frame_NNNNN.vtp per frame and PRESET.pvd (the one format, "
                         "and the default: may be left out)")
+    p.add_argument("--surface", action="store_true",
+                   help="also the liquid surface per frame: surface_NNNNN.vtp (triangles, "
+                        "normals, speed, pressure, height) and PRESET-surface.pvd")
     p.add_argument("--out", type=path_argument, metavar="DIR",
                    help="output folder (default: RECORDINGS/PRESET/vtk)")
     p.add_argument("--recordings", type=path_argument, metavar="DIR",
