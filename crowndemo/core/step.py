@@ -23,7 +23,7 @@ from .params import Model, Numerics, ParameterError, Physics
 from .plane_floor import PlaneFloor
 from .pressure import Pressure
 from .state import FLUID, ParticleState
-from .symmetry import Symmetry, image_room
+from .symmetry import Symmetry, image_room, mirror_whole
 from .terms import CLOSE_SLOTS, Predictor
 
 
@@ -353,7 +353,13 @@ class Simulator:
         self.pressure.density_and_pressure()
 
     def snapshot(self) -> Dict[str, np.ndarray]:
+        """The simulated particles (of a half or quarter with symmetry planes)."""
         return self.state.snapshot()
+
+    def whole_snapshot(self) -> Dict[str, np.ndarray]:
+        """``snapshot`` of the whole scene: a half or quarter mirrored across its planes
+        (symmetry.mirror_whole); the same as ``snapshot`` without planes."""
+        return mirror_whole(self.snapshot(), self.model.mirror_planes)
 
     def counts(self) -> Dict[str, int]:
         return count_kinds(self.state.kind.to_numpy()[: self.state.count])

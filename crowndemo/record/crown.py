@@ -29,7 +29,7 @@ class CrownSink:
         self.log = log
 
     def frame(self, sim: Simulator, index: int, time: float) -> None:
-        snap = sim.snapshot()
+        snap = sim.whole_snapshot()         # a half or quarter run mirrored (symmetry.py)
         m = measure(snap["pos"][snap["kind"] == FLUID], time, self.film, self.drop, self.l0,
                     edge=self.edge)
         for entry in reversed(self.log.frames):

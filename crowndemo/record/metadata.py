@@ -13,6 +13,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Optional, Sequence
 
+from ..core.symmetry import fraction, plane_names, symmetry_name
 from ..strictjson import finite_or_none
 from .files import CHECKPOINT, PathLike, atomic_write_json
 from .runlog import RunLog
@@ -56,6 +57,11 @@ def build(resolved: Resolved, scene: Scene, sim: Simulator, log: RunLog, status:
                                    for k, (key, src) in sorted(resolved.where.items())}},
         "physics": asdict(scene.physics), "sound_speed_m_s": scene.physics.c,
         "model": resolved.model.describe(),
+        # mirror planes (core/symmetry.py): the particles, counts and energies are of the
+        # simulated part, the crown metrics and frames of the whole
+        "symmetry": symmetry_name(sim.model.mirror_planes),
+        "symmetry_planes": plane_names(sim.model.mirror_planes),
+        "simulated_fraction": fraction(sim.model.mirror_planes),
         "particles": {"initial": scene.counts(), "now": sim.counts()},
         "left_out": scene.info.get("left_out", []), "scene_info": scene.info,
         "t_end_s": resolved.t_end, "simulated_s": s.time, "steps": s.steps,

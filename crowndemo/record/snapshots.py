@@ -10,7 +10,7 @@ from __future__ import annotations
 import zipfile
 import zlib
 from pathlib import Path
-from typing import TYPE_CHECKING, Dict
+from typing import TYPE_CHECKING, Dict, Sequence
 
 import numpy as np
 
@@ -42,7 +42,7 @@ class SnapshotSink:
     def frame(self, sim: Simulator, index: int, time: float) -> None:
         sim.refresh_pressure()              # P and n at the frame's positions (output only)
         path = self.folder / frame_name(index)
-        write(path, sim.snapshot(), index, time, self.fluid_only)
+        write(path, sim.snapshot(), index, time, self.fluid_only, sim.model.mirror_planes)
         self.log.add_frame(index, time, path.relative_to(self.recording).as_posix())
 
     def close(self, status: str) -> None:
@@ -50,11 +50,14 @@ class SnapshotSink:
 
 
 def write(path: PathLike, snap: Dict[str, np.ndarray], index: int, time: float,
-          fluid_only: bool = True) -> None:
+          fluid_only: bool = True, symmetry_planes: Sequence[int] = ()) -> None:
+    """One frame's particles; ``symmetry_planes``: the mirror planes of a half or quarter run
+    (core/symmetry.py; axes, 0: x = 0, 1: y = 0), stored so that a reader can mirror it."""
     keep = snap["kind"] == FLUID if fluid_only else slice(None)
     arrays = {k: snap[k][keep] for k in FIELDS}
     atomic_write(path, lambda f: np.savez_compressed(
-        f, time=np.float64(time), index=np.int64(index), **arrays))
+        f, time=np.float64(time), index=np.int64(index),
+        symmetry_planes=np.asarray(tuple(symmetry_planes), dtype=np.int64), **arrays))
 
 
 def open_npz(path: PathLike) -> np.lib.npyio.NpzFile:
@@ -81,6 +84,8 @@ def read(path: PathLike) -> Dict[str, np.ndarray]:
             out = {k: z[k] for k in z.files}
         _check(out)
         out["time"], out["index"] = float(out["time"]), int(out["index"])
+        # the simulated part's mirror planes; none in a whole run (and in older recordings)
+        out["symmetry_planes"] = tuple(int(a) for a in out.get("symmetry_planes", ()))
     except NPZ_ERRORS as e:
         raise SnapshotError(f"{path}: cannot read the snapshot ({why(e)})") from None
     return out

@@ -4,6 +4,9 @@ that lists every frame with its time. ``read`` and ``read_pvd`` parse them back.
 
 Point data: ``velocity`` (vector), ``pressure``, ``number_density``, ``kind``, ``id``; 2D
 positions and velocities get a zero third component. Floats keep the snapshot's precision.
+Field data: ``TimeValue``; for a half or quarter run ``SymmetryPlanes``, the axes of its mirror
+planes through 0 (0: x = 0, 1: y = 0; core/symmetry.py): the points are that part only
+(ParaView's Reflect filter, once per plane, shows the whole).
 """
 from __future__ import annotations
 
@@ -55,9 +58,15 @@ def write(path: PathLike, snap: Dict[str, np.ndarray], time: float = None) -> No
             f'NumberOfComponents="{comps}" format="appended" offset="{offset}"/>')
         payload += [np.uint64(len(raw)).tobytes(), raw]
         offset += 8 + len(raw)
-    field = ("" if time is None else
-             '    <FieldData>\n      <DataArray type="Float64" Name="TimeValue" '
-             f'NumberOfTuples="1" format="ascii">{float(time)!r}</DataArray>\n    </FieldData>\n')
+    fields = [] if time is None else [
+        '      <DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
+        f'format="ascii">{float(time)!r}</DataArray>']
+    planes = tuple(snap.get("symmetry_planes", ()))
+    if planes:      # a half or quarter run (core/symmetry.py): the points are that part only
+        fields.append(f'      <DataArray type="Int32" Name="SymmetryPlanes" NumberOfTuples='
+                      f'"{len(planes)}" format="ascii">{" ".join(map(str, planes))}</DataArray>')
+    field = ("" if not fields else
+             "    <FieldData>\n" + "\n".join(fields) + "\n    </FieldData>\n")
     head = ('<?xml version="1.0"?>\n'
             '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
             'header_type="UInt64">\n  <PolyData>\n' + field +
@@ -93,7 +102,10 @@ def read(path: PathLike) -> Dict[str, np.ndarray]:
     for arr in root.iter("DataArray"):
         name = arr.get("Name")
         if arr.get("format") == "ascii":
-            out["time" if name == "TimeValue" else name] = float(arr.text.split()[0])
+            if name == "SymmetryPlanes":
+                out["symmetry_planes"] = tuple(int(v) for v in arr.text.split())
+            else:
+                out["time" if name == "TimeValue" else name] = float(arr.text.split()[0])
             continue
         at = start + int(arr.get("offset"))
         size = int(np.frombuffer(data, "<u8", 1, at)[0])

@@ -99,7 +99,7 @@ def run_and_observe(sim: Simulator, resolved: config.Resolved, scene_info: Optio
     edge = film_limit(scene_info, resolved.l0)
 
     def observe(sim_, i):
-        snap = sim_.snapshot()
+        snap = sim_.whole_snapshot()        # a half or quarter run mirrored (symmetry.py)
         seen.append(measure(snap["pos"][snap["kind"] == FLUID], sim_.stats.time, s["film"],
                             s["drop"], resolved.l0, edge=edge))
     outcome = "ran to the end"

@@ -1,0 +1,157 @@
+"""Mirror symmetry planes (core/symmetry.py, scenes/symmetric.py): a half or quarter of a
+symmetric scene gives what the whole gives, and nothing crosses a plane."""
+import math
+
+import numpy as np
+import pytest
+
+from crowndemo import config
+from crowndemo.config.errors import PresetError
+from crowndemo.core import FLUID, Numerics, simulator_for
+from crowndemo.core.symmetry import cut, image_room, images_of, mirror_whole, planes_of
+from crowndemo.scenes import dam_break, hydrostatic_tank, square_patch
+from crowndemo.scenes.base import lattice_block
+from crowndemo.scenes.symmetric import halve
+from crowndemo.validate.cases import dam_break_fronts
+
+RHO, G = 998.0, 9.81
+
+
+def test_cut_and_mirror_give_back_the_whole_lattice():
+    l0 = 1.0
+    whole = lattice_block([-4, -3, 0], [4, 3, 2], l0)        # points at (k + 1/2) l0 from 0
+    keep = cut(whole, (0, 1), tol=1e-6)
+    assert keep.sum() * 4 == len(whole)
+    again = mirror_whole({"pos": whole[keep]}, (0, 1))["pos"]
+    as_set = lambda p: {tuple(np.round(x, 6)) for x in p}
+    assert as_set(again) == as_set(whole)
+    with pytest.raises(ValueError, match="not mirror symmetric"):
+        cut(whole + [0.25, 0, 0], (0,), tol=1e-6)
+    with pytest.raises(ValueError, match="on a symmetry plane"):
+        cut(lattice_block([-4.5, 0], [4.5, 1], l0), (0,), tol=1e-6)
+
+
+def test_planes_and_image_counts():
+    assert planes_of("full", 3) == () and planes_of("half", 2) == (0,)
+    assert planes_of("quarter", 3) == (0, 1)
+    with pytest.raises(ValueError):
+        planes_of("quarter", 2)
+    # a 10 x 10 column of a lattice at (k + 1/2) l0: within 2.1 l0 of x = 0 lie the columns
+    # at 0.5 and 1.5 l0 (20 points), the same for y = 0, and 4 points near both
+    pts = lattice_block([0, 0, 0], [10, 10, 1], 1.0)
+    assert images_of(pts, (0,), 2.1) == 20
+    assert images_of(pts, (0, 1), 2.1) == 20 + 20 + 4
+    assert image_room(pts, (), 2.1) == 0
+    assert image_room(pts, (0, 1), 2.1) == 1024       # at least IMAGE_ROOM_MIN
+
+
+@pytest.mark.parametrize("dim,planes", [(2, (0,)), (3, (0, 1))])
+def test_images_complete_every_neighbour_sum(dim, planes):
+    # A block at rest, symmetric about the planes: with the images, every particle of the part
+    # has the number density it has in the whole block (S9 sums the same neighbours)
+    l0 = 1.0e-3
+    whole = square_patch(dim=dim, side=(12 if dim == 2 else 8) * l0, l0=l0)
+    part = halve(whole, planes, [0.0] * dim)
+    densities = []
+    for scene in (whole, part):
+        sim = simulator_for(scene)
+        sim.refresh_pressure()
+        snap = sim.snapshot()
+        densities.append((snap["pos"], snap["number_density"]))
+    (pw, nw), (pp, npart) = densities
+    index = {tuple(np.round(p / l0, 3)): n for p, n in zip(pw, nw)}
+    expected = np.array([index[tuple(np.round(p / l0, 3))] for p in pp])
+    assert np.allclose(npart, expected, rtol=1e-5)
+
+
+def _floor_pressure(sim, x_shift: float, width: float, depth: float, l0: float) -> float:
+    """P at z = 0 from a least-squares line through the fluid away from the walls."""
+    sim.refresh_pressure()
+    s = sim.snapshot()
+    p = s["pos"] + np.array([x_shift, 0.0])
+    inner = (s["kind"] == FLUID) & (p[:, 0] > 3 * l0) & (p[:, 0] < width - 3 * l0)
+    inner &= (p[:, 1] > 3 * l0) & (p[:, 1] < depth - 4 * l0)
+    return float(np.polyfit(p[inner, 1], s["pressure"][inner], 1)[1])
+
+
+def test_half_tank_has_the_whole_tanks_floor_pressure():
+    # the tank of test_physics (rho g H within 5 %); cut at its middle x = W/2, the half must
+    # give the whole tank's floor pressure within 1 % (issue 21), and keep x > 0 throughout
+    width, depth, l0 = 0.04, 0.04, 1.0e-3
+    whole = hydrostatic_tank(dim=2, l0=l0, width=width, depth=depth, nu=1.0e-3)
+    part = halve(whole, (0,), (width / 2, 0.0))
+    floor = {}
+    for name, scene, shift in (("whole", whole, 0.0), ("half", part, width / 2)):
+        sim = simulator_for(scene)
+        fits, lowest = [], []
+
+        def frame(s, i):
+            fits.append(_floor_pressure(s, shift, width, depth, l0))
+            snap = s.snapshot()
+            lowest.append(snap["pos"][snap["kind"] == FLUID, 0].min())
+        sim.run(0.3, frame_times=np.linspace(0.15, 0.3, 7), on_frame=frame)
+        floor[name] = np.mean(fits)
+        if name == "half":
+            assert min(lowest) > 0.0
+    assert floor["whole"] == pytest.approx(RHO * G * depth, rel=0.05)
+    assert floor["half"] == pytest.approx(floor["whole"], rel=0.01)
+
+
+def test_half_dam_break_has_the_whole_surge_front_3d():
+    # a 3D column a x a/2 x 2a, cut at the channel's middle y = a/4: the surge front of the
+    # half (Martin & Moyce's Z = z/a) within 2 % of the whole's (issue 21)
+    a, l0, channel = 0.03, 2.5e-3, 0.5
+    whole = dam_break(dim=3, a=a, l0=l0, channel=channel)
+    part = halve(whole, (1,), (0.0, 0.5 * channel * a, 0.0))
+    fronts = [dam_break_fronts(simulator_for(s), a, 2.0, every=0.5)[1] for s in (whole, part)]
+    assert fronts[0][-1] > 2.0                      # the surge has run out 2 a by T = 2
+    assert np.allclose(fronts[1], fronts[0], rtol=0.02)
+
+
+def test_nothing_crosses_a_plane():
+    # a 2D disc thrown at the plane x = 0: in the whole scene it meets its mirror twin head-on.
+    # No particle is ever on the far side, and the approach is stopped (the twins merge).
+    l0, R, U = 1.0e-4, 1.0e-3, 2.0
+    pts = lattice_block([-R, -R], [R, R], l0)
+    pts = pts[np.linalg.norm(pts, axis=1) <= R] + np.array([R + 2 * l0, 0.0])
+    from crowndemo.core.params import Physics
+    from crowndemo.scenes.base import assemble
+    vel = np.tile([-U, 0.0], (len(pts), 1))
+    physics = Physics(dim=2, l0=l0, v_max=U, gravity=0.0, sound_speed=10 * U)
+    scene = assemble("twins", physics, Numerics(mirror_planes=(0,)), pts, vel, None,
+                     ((-20 * R, -100 * R), (20 * R, 100 * R)), 2.0 * R / U, {})
+    sim = simulator_for(scene)
+    lowest = []
+    sim.run(scene.t_end, on_step=lambda s: lowest.append(
+        s.state.pos.to_numpy()[: s.state.count, 0].min()))
+    assert min(lowest) >= 0.0
+    u = sim.snapshot()["vel"]
+    assert abs(u[:, 0].mean()) < 0.2 * U            # the approach at -U has stopped
+    assert sim.stats.health.left_total == 0 and math.isfinite(sim.stats.health.energy)
+
+
+def test_preset_symmetry_key():
+    r = config.load("3m-drop", "draft", ["scene.symmetry=quarter"])
+    assert r.numerics.mirror_planes == (0, 1) and r.model.mirror_planes == (0, 1)
+    assert config.load("3m-drop", "draft", []).numerics.mirror_planes == ()
+    with pytest.raises(PresetError) as e:
+        config.load("3m-drop", "draft", ["dim=2", "scene.symmetry=quarter"])
+    assert "scene.symmetry" in str(e.value) and "full or half" in str(e.value)
+    with pytest.raises(PresetError, match="scene.symmetry"):
+        config.load("3m-drop", "draft", ["scene.symmetry=eighth"])
+
+
+def test_snapshots_and_vtk_say_the_run_is_a_part(tmp_path):
+    from crowndemo.record import snapshots, vtk
+    n = 5
+    snap = {"pos": np.random.default_rng(1).random((n, 3)), "vel": np.zeros((n, 3)),
+            "pressure": np.zeros(n), "number_density": np.zeros(n),
+            "kind": np.zeros(n, np.int32), "id": np.arange(n, dtype=np.int32)}
+    snapshots.write(tmp_path / "q.npz", snap, 0, 1e-3, symmetry_planes=(0, 1))
+    snapshots.write(tmp_path / "w.npz", snap, 0, 1e-3)
+    quarter, whole = snapshots.read(tmp_path / "q.npz"), snapshots.read(tmp_path / "w.npz")
+    assert quarter["symmetry_planes"] == (0, 1) and whole["symmetry_planes"] == ()
+    vtk.write(tmp_path / "q.vtp", quarter, quarter["time"])
+    vtk.write(tmp_path / "w.vtp", whole, whole["time"])
+    assert vtk.read(tmp_path / "q.vtp")["symmetry_planes"] == (0, 1)
+    assert "symmetry_planes" not in vtk.read(tmp_path / "w.vtp")
