@@ -1,6 +1,7 @@
 """The liquid surface (render/surface.py) against geometry: a ball, a film, a thin sheet,
 droplets, and the mirroring of a quarter or half run into the whole."""
 import math
+import os
 
 import numpy as np
 import pytest
@@ -160,3 +161,22 @@ def test_plane_names():
 def test_no_particles_no_mesh():
     mesh = reconstruct(np.zeros((0, 3)), L0, {"speed": np.zeros(0)})
     assert mesh.n_vertices == 0 and mesh.n_triangles == 0 and "speed" in mesh.fields
+
+
+def test_splashsurf_threads_follow_taichis(monkeypatch):
+    """RAYON_NUM_THREADS (splashsurf's pool) is Taichi's CPU thread count unless set."""
+    import taichi as ti
+
+    from crowndemo.render.surface import limit_threads
+    monkeypatch.delenv("RAYON_NUM_THREADS", raising=False)
+    limit_threads(3)
+    assert os.environ["RAYON_NUM_THREADS"] == "3"
+    limit_threads(5)                                   # a set value is kept
+    assert os.environ["RAYON_NUM_THREADS"] == "3"
+    monkeypatch.delenv("RAYON_NUM_THREADS")
+    limit_threads()
+    if ti.lang.impl.get_runtime().prog is not None:
+        expected = ti.lang.impl.current_cfg().cpu_max_num_threads
+    else:
+        expected = os.cpu_count()
+    assert os.environ["RAYON_NUM_THREADS"] == str(expected)
