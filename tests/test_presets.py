@@ -62,13 +62,26 @@ def test_preset_values_follow_the_seed():
 
 
 @pytest.mark.parametrize("name", sorted(SHIPPED))
-def test_shipped_presets_keep_the_seeds_sound_speed(name):
-    """c = 5 U (S8) for every shipped preset at every quality: the slow-drop floor (the fall
-    and capillary speeds, config/resolve.py) does not reach U there."""
+def test_shipped_presets_sound_speed_rule(name):
+    """c = k U (S8) for every shipped preset at every quality: k = 10 for the crown presets
+    (config/sound_speed.py; the seed's 5 stops the 3m-drop at contact at D/l0 = 100,
+    VALIDATION.md "Sound speed"), the seed's k = 5 kept by the quick smoke tests; the slow-drop
+    floor (the fall and capillary speeds, config/resolve.py) does not reach U there."""
+    k = 5.0 if name.startswith("quick") else 10.0
     for quality in config.QUALITIES:
         r = config.load(name, quality)
-        assert r.scene.get("sound_speed") is None
-        assert r.physics.c == pytest.approx(5.0 * r.speed, rel=1e-12)
+        assert r.scene["sound_speed_factor"] == k
+        assert r.physics.c == pytest.approx(k * r.speed, rel=1e-12)
+        assert r.scene["sound_speed_source"] == f"{k:g} x speed"
+
+
+def test_the_seeds_sound_speed_stays_selectable():
+    """scene.sound_speed_factor = 5 gives the seed's c = 5 U; scene.sound_speed gives c."""
+    r = config.load("3m-drop", "draft", ["scene.sound_speed_factor=5"])
+    assert r.physics.c == pytest.approx(40.0) and r.where["sound_speed"][0] == \
+        "scene.sound_speed_factor"
+    r = config.load("3m-drop", "draft", ["scene.sound_speed=123"])
+    assert r.physics.c == 123.0 and r.where["sound_speed"][0] == "scene.sound_speed"
 
 
 def test_a_slow_drop_takes_its_sound_speed_from_the_capillary_speed():
@@ -134,7 +147,7 @@ def test_info_preset_text_and_json(capsys):
     d = json.loads(capsys.readouterr().out)
     n0, lam = n0_lambda0(3, 3e-4, 2.1 * 3e-4)
     assert d["n0"] == pytest.approx(n0) and d["lambda0"] == pytest.approx(lam)
-    assert d["sound_speed_m_s"] == pytest.approx(40.0)
+    assert d["sound_speed_m_s"] == pytest.approx(10 * 8.0)     # c = 10 U (config/sound_speed.py)
     assert d["dt_s"] == min(v for v in d["limits_s"].values() if v is not None)
     assert d["binding"] in d["binding_ties"]
     p = d["particles"]
@@ -143,20 +156,23 @@ def test_info_preset_text_and_json(capsys):
     assert d["steps"] > d["steps_at_U"] and d["run_seconds_estimate"] > d["run_seconds_at_U"]
     assert d["left_out"] == [] or all(isinstance(s, str) for s in d["left_out"])
     # the crown presets take the Courant limit on relative speeds (README, the paragraph of
-    # that name):
-    # after contact at 0.3 c relative (the approach limit at the splash's 0.5 c), against
-    # 0.5 c for the seed's absolute form, so fewer steps
+    # that name): after contact the splash's speeds scale with U (estimate.py; the sound-speed
+    # study, VALIDATION.md): 1.5 U relative, and the approach limit at the splash's 4 U at
+    # D/l0 = 30 growing as (D/l0)^0.36; the acoustic limit l0/c binds here, at 0.9 of it
     assert d["numerics"]["courant_speed"] == "relative"
     assert d["limits_s"]["approach"] == pytest.approx(0.5 * 3e-4 / 8.0)
-    c = d["sound_speed_m_s"]
-    assert d["relative_speed_m_s"] == pytest.approx(0.3 * c)
-    assert d["dt_after_contact_s"] == pytest.approx(
-        min(0.2 * 3e-4 / (0.3 * c), 0.5 * 3e-4 / (0.5 * c), 3e-4 / c))
+    c, U, l0 = d["sound_speed_m_s"], 8.0, 3e-4
+    splash = 4.0 * U * (1e-2 / l0 / 30) ** 0.36
+    assert d["relative_speed_m_s"] == pytest.approx(1.5 * U)
+    assert d["splash_speed_m_s"] == pytest.approx(splash)
+    assert d["binding_after_contact"] == "acoustic"
+    assert d["dt_after_contact_s"] == pytest.approx(0.9 * min(
+        0.2 * l0 / (1.5 * U), 0.5 * l0 / splash, l0 / c))
     assert main(["info", "3m-drop", "--quality", "booth", "--json",
                  "--set", "numerics.courant_speed=absolute"]) == 0
     a = json.loads(capsys.readouterr().out)
     assert "approach" not in a["limits_s"] and a["relative_speed_m_s"] is None
-    assert a["dt_after_contact_s"] == pytest.approx(0.2 * 3e-4 / (0.5 * c))
+    assert a["dt_after_contact_s"] == pytest.approx(0.2 * l0 / splash)     # the Courant limit
     assert a["steps"] > d["steps"]
 
 
@@ -238,7 +254,14 @@ BAD = [  # (id, file text, quality, fragments of the message after "<file>: ")
      ["scene.height = 1.0: give scene.speed or scene.height, not both"]),
     ("no speed", _with("  speed: 3.0\n", ""), "draft",
      ["scene.speed = (missing): no impact speed", "scene.height", "allowed: > 0 and <= 50 m/s"]),
+    ("sound speed factor too small", _with("speed: 3.0", "speed: 3.0\n  sound_speed_factor: 1.5"),
+     "draft", ["scene.sound_speed_factor = 1.5: out of range", "allowed: >= 2 and <= 100"]),
     ("dt below 1e-8 s", _with("speed: 3.0", "speed: 40").replace("l0: 3.0e-4", "l0: 1.0e-6"),
+     "draft", ["scene.sound_speed_factor = 10.0: the time step would be 2.5e-09 s (bound by "
+               "the acoustic limit), below 1e-08 s",
+               "allowed: <= 2.5 at U = 40 m/s and l0 = 1e-06 m (c = k U)"]),
+    ("dt below 1e-8 s at the seed's c", _with("speed: 3.0", "speed: 40\n  sound_speed_factor: 5")
+     .replace("l0: 3.0e-4", "l0: 1.0e-6"),
      "draft", ["scene.speed = 40.0: the time step would be 5e-09 s (bound by the courant "
                "limit), below 1e-08 s", "allowed: U <= 20 m/s at l0 = 1e-06 m"]),
     ("l0 too coarse for the film", _with("l0: 3.0e-4", "l0: 5.0e-4"), "draft",

@@ -80,9 +80,10 @@ def _preset_facts(r, tp) -> Dict:
     }
 
 
-def _speed_in_c(v: float, c: float) -> str:
-    """'8 m/s = 0.2 c': a speed and its ratio to the sound speed c."""
-    return f"{v:.3g} m/s = {v / c:.2g} c"
+def _speed_in_c(v: float, c: float, U: float) -> str:
+    """'32 m/s = 4 U = 0.4 c': a speed and its ratios to the impact speed U and to the sound
+    speed c."""
+    return f"{v:.3g} m/s = {v / U:.2g} U = {v / c:.2g} c"
 
 
 def _mm(x: float) -> str:
@@ -180,10 +181,11 @@ def info_preset(args) -> int:
               f"(Taichi's 32-bit field indices): a run would be refused; l0 >= ~{_mm(need)}")
     print(f"  memory      ~{estimate.human_bytes(f['memory_bytes'])} ({tp.bytes_per_particle:g} "
           f"bytes per particle with the cell grid, f32)")
-    c = f["sound_speed_m_s"]          # the speeds are max(U, k c): state their own ratio
-    speeds = f"the splash's ~{_speed_in_c(f['splash_speed_m_s'], c)}"
+    c, U = f["sound_speed_m_s"], r.speed     # the splash's speeds scale with U (estimate.py)
+    speeds = f"the splash's ~{_speed_in_c(f['splash_speed_m_s'], c, U)}"
     if relative:
-        speeds = f"a relative speed of ~{_speed_in_c(f['relative_speed_m_s'], c)}, {speeds}"
+        speeds = (f"a relative speed of ~{_speed_in_c(f['relative_speed_m_s'], c, U)}, "
+                  f"{speeds}")
     print(f"  steps       ~{f['steps']:,} to t_end: dt {f['dt_s']:.3g} s until contact, then "
           f"{f['dt_after_contact_s']:.3g} s ({f['binding_after_contact']} at {speeds}); at "
           f"least {f['steps_at_U']:,} (v = U all along)")

@@ -113,9 +113,11 @@ def _presets(args) -> int:
                 f"{estimate.FIRST_RUN_COMPILE_S[3]:g} s in 3D; 3-9 s with the kernels in "
                 f"Taichi's cache) + every particle x steps x {estimate.CROWN_COST:g} (a crown step's cost) / "
                 f"{tp.rate_total:.3g} particle-steps/s ({tp.rate:.3g} fluid; {tp.source}); "
-                f"steps: dt at the drop's speed until contact, then at the splash's "
-                f"{estimate.SPLASH_MACH:g} c, or with the Courant limit on relative speeds "
-                f"at {estimate.SPLASH_RELATIVE_MACH:g} c relative (measured). Details: "
+                f"steps: dt at the drop's speed U until contact, then at the splash's "
+                f"{estimate.SPLASH_SPEED_U:g} U at D/l0 = {estimate.SPLASH_AT_D_L0:g} "
+                f"(x (D/l0 / {estimate.SPLASH_AT_D_L0:g})^{estimate.SPLASH_GROWTH:g}) and, "
+                f"with the Courant limit on relative speeds, {estimate.RELATIVE_SPEED_U:g} U "
+                f"relative (measured, VALIDATION.md \"Sound speed\"). Details: "
                 f"crowndemo info PRESET --quality Q.", 96):
             print(line)
     for e in errors:

@@ -2,17 +2,19 @@
 scene built with numpy, or scaled from a coarser build when it would be large), steps to the
 end time, memory, and a run-time estimate from the throughput recorded in BENCHMARKS.md.
 
-Two figures measured on crown runs (2026-11-22, AMD EPYC, 2 cores, f32) correct the bench:
+Figures measured on crown runs correct the bench:
 
-- after the drop touches the film, the splash's fastest particles move at about 0.5 c with
-  the particle collision model (2m-drop draft: 15.7 m/s at c = 31.3 m/s; 3m-drop draft:
-  20.1 m/s at c = 40 m/s; 0.85 c before the model, when collapsing surface pairs were kicked
-  apart), so from contact on the Courant limit binds at v ~ 0.5 c, not at the drop's speed U;
-- with ``courant_speed: relative`` (the crown presets), the Courant limit binds at the largest
-  speed relative to neighbours, walls at rest: after contact about 0.3 c, the spreading film's
-  base sliding over the floor (booth 3m-drop, 2.5m-drop, 20cm-drop: 685, 620 and 338 steps,
-  a mean dt after contact of 0.26, 0.27 and 0.35 c in relative speed; 10.9 m/s at 1 ms of the
-  3m-drop, against 23.6 m/s for the fastest spray), and the approach limit at the splash speed;
+- after the drop touches the film, the splash sets dt. Its speeds scale with the impact speed U,
+  not with the sound speed c: the sound-speed study (VALIDATION.md "Sound speed", the 3m-drop
+  at c = 5, 10 and 20 U, 2026-12-01) measured a mean dt after contact of 0.125 l0/U in 2D and
+  0.131 l0/U in 3D at D/l0 = 30 and c = 5 U, bound by the approach limit 0.5 l0/v at the
+  splash's v = 4 U and the Courant limit 0.2 l0/v_rel at a relative speed of 1.5 U (walls at
+  rest; the booth runs of 2026-11-22 at c = 5 U: 0.26-0.35 c = 1.3-1.75 U), and 0.081 l0/U at
+  D/l0 = 100 (2D, c = 10 and 20 U: the approach limit at 6.2 U). The splash speed grows with
+  the resolution as (D/l0)^0.36 through those two points (issue 21: 4-5 U at D/l0 = 100 and
+  more as the spacing refines);
+- where the acoustic limit l0/c binds (c >= 10 U) the mean dt after contact is 0.88-0.95 of
+  it (a few steps bound by a faster splash or the relative Courant limit): STEP_MIX;
 - a crown step costs about 0.8 of a bench step per particle, counting every particle (the
   booth 3m-drop, `crowndemo bench --preset 3m-drop`: 643,033 particles x 1,442 steps in 286 s
   = 3.2e6 particle-steps/s, against the bench's 2.6e6 at 300k; the floor's dummy particles
@@ -40,8 +42,11 @@ BUILD_AT_MOST = 3.0e6        # a coarse build that must resolve a thin film may 
 FALLBACK_RATE = 8.0e5        # fluid particle-steps/s, 3D, f32
 FALLBACK_COMPILE_S = 5.0
 FALLBACK_BYTES = 92.0        # per particle (fields + cell grid), f32
-SPLASH_MACH = 0.5            # fastest particle / c after contact (measured, see above)
-SPLASH_RELATIVE_MACH = 0.3   # largest relative speed / c after contact (measured, see above)
+SPLASH_SPEED_U = 4.0         # the splash's speed / U after contact at D/l0 = SPLASH_AT_D_L0
+SPLASH_AT_D_L0 = 30.0
+SPLASH_GROWTH = 0.36         # ... times (D/l0 / SPLASH_AT_D_L0)^this (6.2 U at D/l0 = 100)
+RELATIVE_SPEED_U = 1.5       # largest relative speed / U after contact (measured, see above)
+STEP_MIX = 0.9               # mean dt after contact / the smallest limit (measured, see above)
 CROWN_COST = 0.8             # a crown step's cost per particle / the bench's (measured)
 # A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
 # (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
@@ -194,24 +199,33 @@ def rough_counts(r: Resolved) -> Dict:
             "walls": None, "extent_m": parts["extent_m"]}
 
 
+def splash_speed(U: float, drop_over_l0: float) -> float:
+    """The splash's speed after contact (m/s): SPLASH_SPEED_U U at D/l0 = SPLASH_AT_D_L0,
+    growing as (D/l0)^SPLASH_GROWTH (measured, see the module's docstring)."""
+    return U * SPLASH_SPEED_U * (max(drop_over_l0, 1.0) / SPLASH_AT_D_L0) ** SPLASH_GROWTH
+
+
 def steps_to_end(r: Resolved) -> Dict:
     """Steps to t_end. ``steps_at_U``: dt = the smallest limit at v = U all along (a floor);
-    ``steps``: that until the drop touches the film (gap / U), then dt at v = SPLASH_MACH c
-    (and, with the relative Courant limit, a relative speed of SPLASH_RELATIVE_MACH c)."""
+    ``steps``: that until the drop touches the film (gap / U), then dt at the splash's speed
+    (``splash_speed``) and, with the relative Courant limit, a relative speed of
+    RELATIVE_SPEED_U U (STEP_MIX x dt where the acoustic limit binds); every frame shortens
+    one step."""
     lim = r.limits()
     dt, binding = r.dt()
     frames = len(r.frame_times())
     contact = min(r.scene["gap"] / r.speed, r.t_end)
-    v_splash = max(r.speed, SPLASH_MACH * r.physics.c)
+    v_splash = max(r.speed, splash_speed(r.speed, r.scene["drop"] / r.l0))
     v_relative = None
     if r.numerics.courant_speed == "relative":
-        v_relative = max(r.speed, SPLASH_RELATIVE_MACH * r.physics.c)
+        v_relative = RELATIVE_SPEED_U * r.speed
     after = timestep.choose(r.physics, r.numerics, r.model, v_splash, v_relative)
-    steps = math.ceil(contact / dt - 1e-9) + math.ceil((r.t_end - contact) / after[0] - 1e-9)
+    dt_after = after[0] * (STEP_MIX if after[1] == "acoustic" else 1.0)
+    steps = math.ceil(contact / dt - 1e-9) + math.ceil((r.t_end - contact) / dt_after - 1e-9)
     return {"dt_s": dt, "binding": binding, "limits_s": lim,
             "steps_at_U": int(math.ceil(r.t_end / dt - 1e-9)) + frames,
             "splash_speed_m_s": v_splash, "relative_speed_m_s": v_relative,
-            "dt_after_contact_s": after[0],
+            "dt_after_contact_s": dt_after,
             "binding_after_contact": after[1], "steps": int(steps) + frames}
 
 
@@ -235,7 +249,7 @@ def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Di
     secs = run_seconds(counts["total"], st["steps"], tp, r.dim)
     return {"particles": counts, **st, "run_seconds": secs, "compile_seconds":
             FIRST_RUN_COMPILE_S[r.dim],
-            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, r.dim, 1.0),
+            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, r.dim),
             "memory_bytes": memory_bytes(counts["total"], tp)}
 
 
@@ -264,5 +278,6 @@ def human_bytes(b: float) -> str:
     return f"{b:.0f} B"
 
 
-__all__ = ["Throughput", "throughput", "particle_counts", "steps_to_end", "run_seconds",
+__all__ = ["Throughput", "throughput", "particle_counts", "steps_to_end", "splash_speed",
+           "run_seconds",
            "memory_bytes", "summary", "human_seconds", "human_count", "human_bytes"]

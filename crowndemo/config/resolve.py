@@ -15,6 +15,7 @@ from .errors import MISSING, PresetError
 from .loader import Document
 from .merge import DEFAULT_SOURCE
 from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
+from .sound_speed import FACTOR_RANGE, sound_speed
 
 if TYPE_CHECKING:
     from ..scenes.base import Scene
@@ -218,14 +219,22 @@ def resolve(doc: Document, quality: str) -> Resolved:
     name = liq.pop("name", "water")
     liquid = {"name": name, **LIQUIDS[name], **liq}
 
-    # the sound speed: c = 5 v_max (S8), v_max the scene's largest speed scale
+    # the sound speed: c = k v_max (S8), k = scene.sound_speed_factor (config/sound_speed.py),
+    # v_max the scene's largest speed scale: U, or the fall or capillary speed of a slow drop
+    derived = None        # c given; else what k multiplies: "speed", "fall" or "capillary"
+    k = scene["sound_speed_factor"]
     if scene.get("sound_speed") is None:
         floor, which = slow_speed_floor(dim, l0, scene, liquid)
         if floor > scene["speed"]:
-            scene["sound_speed"] = SOUND_SPEED_FACTOR * floor
-            scene["sound_speed_source"] = (f"5 x the {which} speed {floor:.3g} m/s, above "
+            scene["sound_speed"] = sound_speed(k, floor)
+            scene["sound_speed_source"] = (f"{k:g} x the {which} speed {floor:.3g} m/s, above "
                                            f"U = {scene['speed']:.3g} m/s")
             where["sound_speed"] = where["speed"]
+        else:
+            scene["sound_speed"] = sound_speed(k, scene["speed"])
+            scene["sound_speed_source"] = f"{k:g} x speed"
+            where["sound_speed"] = where["sound_speed_factor"]
+        derived = which if floor > scene["speed"] else "speed"
 
     # the core's own checks (the schema's ranges make these pass; kept as a safety net)
     try:
@@ -245,7 +254,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
         raise PresetError(doc.label, f"scene.liquid.{e.key}", e.value, "refused by the solver",
                           e.allowed) from None
     model = Model.of(physics, numerics)
-    _check_mach(scene, numerics, physics, fail)
+    _check_mach(scene, numerics, physics, fail, where, derived)
 
     # the time step
     lim = timestep.limits(physics, numerics, model, scene["speed"])
@@ -263,20 +272,24 @@ def resolve(doc: Document, quality: str) -> Resolved:
         if dt_name in ("courant", "approach"):
             fail("speed", scene.get("height", scene["speed"]), why,
                  f"U <= {getattr(numerics, dt_name) * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
-        elif dt_name == "acoustic" and "sound_speed_source" in scene:
+        elif dt_name == "acoustic" and derived in ("fall", "capillary"):
             # c from the slow drop's floor: the capillary speed falls as 1/sqrt(l0)
             c = scene["sound_speed"]
-            need = (DT_FLOOR * c / numerics.acoustic if which == "fall" else
+            need = (DT_FLOOR * c / numerics.acoustic if derived == "fall" else
                     (DT_FLOOR * c * math.sqrt(l0) / numerics.acoustic) ** (2.0 / 3.0))
             fail("l0", l0, f"{why}; c = {scene['sound_speed_source']}",
                  f">= {need * 1.001:.4g} m")
-        elif dt_name == "acoustic" and scene.get("sound_speed") is not None:
+        elif dt_name == "acoustic" and derived is None:
             fail("sound_speed", scene["sound_speed"], why,
                  f"<= {numerics.acoustic * l0 / DT_FLOOR:.4g} m/s at l0 = {l0:g} m")
         elif dt_name == "acoustic":
-            u_max = numerics.acoustic * l0 / (SOUND_SPEED_FACTOR * DT_FLOOR)
+            k_max = numerics.acoustic * l0 / (scene["speed"] * DT_FLOOR)
+            if k_max >= FACTOR_RANGE[0]:
+                fail("sound_speed_factor", k, why, f"<= {k_max:.4g} at U = "
+                     f"{scene['speed']:.4g} m/s and l0 = {l0:g} m (c = k U)")
+            u_max = numerics.acoustic * l0 / (k * DT_FLOOR)
             fail("speed", scene.get("height", scene["speed"]), why,
-                 f"U <= {u_max:.4g} m/s at l0 = {l0:g} m (c = {SOUND_SPEED_FACTOR:g} U)")
+                 f"U <= {u_max:.4g} m/s at l0 = {l0:g} m (c = {k:g} U)")
         elif dt_name == "viscous":
             need = timestep.l0_at_dt("viscous", physics, numerics, DT_FLOOR)
             fail("l0", l0, why, f">= {need:.3g} m at nu = {liquid['nu']:g} m^2/s")
@@ -322,20 +335,26 @@ def _speed_source(doc: Document) -> str:
     return doc.label
 
 
-def _check_mach(scene: dict, numerics: Numerics, physics: Physics, fail) -> None:
+def _check_mach(scene: dict, numerics: Numerics, physics: Physics, fail, where: dict,
+                derived: Optional[str] = None) -> None:
     """The run stops as soon as a particle is faster than max_mach * c (core.health), and the
-    drop starts at U and gains speed as it falls: max_mach * c must exceed U."""
+    drop starts at U and gains speed as it falls: max_mach * c must exceed U. ``derived``:
+    None when scene.sound_speed gives c, else what scene.sound_speed_factor multiplies."""
     U, c, mach = scene["speed"], physics.c, numerics.max_mach
     if not starts_too_fast(U, c, mach):
         return
     why = (f"the run would stop at its first step: it stops when a particle is faster than "
            f"numerics.max_mach * c = {mach:g} x {c:.4g} m/s, and the drop starts at "
            f"U = {U:.4g} m/s")
-    if scene.get("sound_speed") is not None:
+    if derived is None:
         fail("sound_speed", c, why, f"> U / max_mach = {U / mach:.4g} m/s")
+    k = scene["sound_speed_factor"]
+    if derived == "speed" and "numerics.max_mach" not in where and \
+            1.0 / mach <= FACTOR_RANGE[1]:     # the preset's own k is too small: name it
+        fail("sound_speed_factor", k, why, f"> 1 / max_mach = {1.0 / mach:.4g} (c = k U)")
     fail("numerics.max_mach", mach, why,
-         f"> U / c = {U / c:.4g} (c = 5 U unless scene.sound_speed is set or U is below the "
-         "fall and capillary speeds)")
+         f"> U / c = {U / c:.4g} (c = scene.sound_speed_factor x U unless scene.sound_speed "
+         "is set or U is below the fall and capillary speeds)")
 
 
 __all__ = ["Resolved", "resolve", "slow_speed_floor", "SPEED_MAX", "DT_FLOOR", "MIN_ACROSS"]

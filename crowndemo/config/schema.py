@@ -7,7 +7,7 @@ A preset (SI units throughout; lengths in m, times in s, speeds in m/s)::
     extends:     OTHER                     # optional; handled by the loader
     dim:         3                         # 3, or 2 for a cross-section (a cylinder-drop slice)
     scene:       {floor, film, drop, speed | height, gap, liquid, gravity, t_end,
-                  frame_interval, trim, re_ratio, sound_speed}
+                  frame_interval, trim, re_ratio, sound_speed_factor, sound_speed}
     numerics:    {courant, acoustic, ...}  # overrides of crowndemo.core.params.Numerics
     quality:     {draft: RUNG, booth: RUNG, seed: RUNG}
     RUNG:        {l0, t_end, frame_interval, numerics}
@@ -25,6 +25,7 @@ from typing import Any, Dict, Iterable, Optional, Tuple
 from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, WALL_MODELS, WATER
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
+from .sound_speed import DEFAULT_FACTOR, FACTOR_RANGE
 
 QUALITIES = ("draft", "booth", "seed")
 LANGUAGES = ("en", "ja")
@@ -121,9 +122,13 @@ SCENE_KEYS = {
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
                   default=True),
     "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
-    "sound_speed": number("artificial sound speed c (default 5 U, S8, or 5 x the fall or "
-                          "capillary speed of a slower drop); above U / max_mach",
-                          "m/s", 0, 1.0e5),
+    "sound_speed_factor": number("c / U: the artificial sound speed c is this many times "
+                                 "the impact speed U (S8), or the fall or capillary speed of "
+                                 "a slower drop (the seed's 5; config/sound_speed.py)", "",
+                                 FACTOR_RANGE[0], FACTOR_RANGE[1], lo_incl=True,
+                                 default=DEFAULT_FACTOR),
+    "sound_speed": number("artificial sound speed c, instead of sound_speed_factor x U; "
+                          "above U / max_mach", "m/s", 0, 1.0e5),
 }
 
 _C = dict(lo=0, hi=2)
