@@ -52,7 +52,8 @@ def preset_height(base: config.Resolved) -> float:
 
 def unstable_advice(e: InstabilityError) -> str:
     """The panel's line for a run that went unstable: when, what broke, and which sliders
-    help (a thin film under a big drop from high up throws a splash faster than c = 5 U)."""
+    help (a thin film under a big drop from high up threw a splash faster than c at the
+    seed's c = 5 U)."""
     return (f"unstable at t = {e.time * 1e3:.3g} ms: {e.what}; try a thicker film, a smaller "
             "drop or a lower fall height")
 
