@@ -16,8 +16,9 @@ radius being l0/2 (tests/test_surface.py holds the geometric checks):
   crown wall shades as one smooth sheet instead of facets (0.08 s a frame there).
 
 A run with symmetry planes (x = 0 and/or y = 0, through the drop's axis) is reconstructed once
-from its part plus a band of mirror images across each plane, cut at the planes, and the mesh
-mirrored into the whole (``mirror``): the copies share their vertices on the planes, no seam.
+from its part plus a band of mirror images across each plane (wide enough that the smoothing
+near a plane sees both sides), cut at the planes, and the mesh mirrored into the whole
+(``mirror``): the copies share their vertices on the planes, no seam.
 A 2D slice (x, z) is extruded into a few layers along y, so that it reads as a thin slab.
 """
 from __future__ import annotations
@@ -46,6 +47,12 @@ class SurfaceParams:
 
     def cube_size(self, l0: float) -> float:
         return self.cube * 0.5 * l0
+
+    def band(self, l0: float) -> float:
+        """How far beyond a symmetry plane mirror images are needed: the kernel's reach, and
+        the reach of the smoothing (one cube a iteration) from the band's own false edge."""
+        iters = max(self.smoothing_iters, self.normal_iters) + 2
+        return self.support(l0) + iters * self.cube_size(l0)
 
 
 @dataclass
@@ -148,25 +155,45 @@ def reconstruct(pos: np.ndarray, l0: float, fields: Optional[Mapping[str, np.nda
     axes = plane_axes(planes)
     if p.shape[0] == 0:
         return SurfaceMesh.empty(values)
-    kwargs = {}
     if axes:
-        band = params.support(l0) + 2 * params.cube_size(l0)
-        p, values = _with_images(p, values, axes, band)
-        lo, hi = p.min(axis=0) - band, p.max(axis=0) + band
-        lo[list(axes)] = 0.0
-        kwargs = dict(mesh_aabb_min=lo.tolist(), mesh_aabb_max=hi.tolist(),
-                      mesh_aabb_clamp_vertices=True)
+        p, values = _with_images(p, values, axes, params.band(l0))
     out, _ = pysplashsurf.reconstruction_pipeline(
         p, attributes_to_interpolate=values or None, particle_radius=0.5 * l0,
         smoothing_length=params.smoothing, cube_size=params.cube,
         iso_surface_threshold=params.iso, mesh_smoothing_iters=params.smoothing_iters or None,
-        compute_normals=True, normals_smoothing_iters=params.normal_iters or None, **kwargs)
+        compute_normals=True, normals_smoothing_iters=params.normal_iters or None)
     attrs = out.point_attributes
     mesh = SurfaceMesh(np.asarray(out.mesh.vertices, dtype=np.float64),
                        np.asarray(out.mesh.triangles, dtype=np.int64).reshape(-1, 3),
                        np.asarray(attrs["normals"], dtype=np.float64),
                        {k: np.asarray(attrs[k], dtype=np.float64) for k in values})
-    return mirror(mesh, planes) if axes and whole else mesh
+    if not axes:
+        return mesh
+    mesh = _cut(mesh, axes)
+    return mirror(mesh, planes) if whole else mesh
+
+
+def _cut(mesh: SurfaceMesh, axes: Tuple[int, ...]) -> SurfaceMesh:
+    """The mesh cut at the planes (as splashsurf's mesh AABB does, but after its smoothing,
+    which then saw both sides): triangles wholly beyond a plane dropped, the vertices of the
+    others beyond it moved onto it; on a plane a normal loses its component across it."""
+    ax = list(axes)
+    inside = np.all(mesh.vertices[:, ax] > 0.0, axis=1)
+    tris = mesh.triangles[inside[mesh.triangles].any(axis=1)]
+    used = np.unique(tris)
+    v, n = mesh.vertices[used].copy(), mesh.normals[used].copy()
+    sub = v[:, ax]
+    beyond = sub < 0.0
+    sub[beyond] = 0.0
+    v[:, ax] = sub
+    nsub = n[:, ax]
+    nsub[beyond | (sub == 0.0)] = 0.0
+    n[:, ax] = nsub
+    length = np.linalg.norm(n, axis=1, keepdims=True)
+    n = np.where(length > 0, n / np.where(length > 0, length, 1.0), mesh.normals[used])
+    index = np.full(mesh.n_vertices, -1, np.int64)
+    index[used] = np.arange(len(used))
+    return SurfaceMesh(v, index[tris], n, {k: f[used] for k, f in mesh.fields.items()})
 
 
 def mirror(mesh: SurfaceMesh, planes: Sequence[str]) -> SurfaceMesh:
