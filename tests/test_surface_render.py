@@ -135,3 +135,33 @@ def test_quick_surface_frames(quick):
     t = meta["render"]
     assert t["style"] == "surface" and 0 < t["surface_seconds"] < t["render_seconds"]
     assert t["surface_seconds_per_frame"] == pytest.approx(t["surface_seconds"] / len(frames))
+
+
+def test_style_options():
+    """record: surface by default in milk, --style particles in speed; live (no --style)
+    draws spheres; a resumed recording is told its style again."""
+    import argparse
+
+    from crowndemo.cli.record import _option_words
+    from crowndemo.render.options import add_render_options, settings_from_args
+    rec = argparse.ArgumentParser()
+    add_render_options(rec)
+    s = settings_from_args(rec.parse_args([]))
+    assert (s.style, s.colour) == ("surface", "milk")
+    s = settings_from_args(rec.parse_args(["--style", "particles"]))
+    assert (s.style, s.colour) == ("particles", "speed")
+    s = settings_from_args(rec.parse_args(["--colour", "pressure"]))
+    assert (s.style, s.colour) == ("surface", "pressure")
+    live = argparse.ArgumentParser()
+    add_render_options(live, lang=False, recording=False)
+    with pytest.raises(SystemExit):
+        live.parse_args(["--style", "surface"])
+    s = settings_from_args(live.parse_args([]))
+    assert (s.style, s.colour) == ("particles", "speed")
+    base = {"render": True, "resolution": [1280, 720], "lang": "en", "orbit": 0.0,
+            "fps": 12.0, "video": True, "all_particles": False, "checkpoint_every": 1}
+    assert _option_words({**base, "style": "surface", "colour": "milk"}) == []
+    assert _option_words({**base, "style": "particles", "colour": "speed"}) == [
+        "--style", "particles"]
+    # a recording made before --style was drawn with spheres
+    assert _option_words({**base, "colour": "speed"}) == ["--style", "particles"]

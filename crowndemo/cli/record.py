@@ -24,10 +24,13 @@ examples:
   crowndemo record 2m-drop --playlist presets/booth.txt   # then the seed's other scenes
   crowndemo record 3m-drop --resume               # continue after Ctrl-C (same options)
   crowndemo record quick --set scene.t_end=5e-4 --checkpoint-every 4
+  crowndemo record quick --style particles --colour speed   # spheres coloured by speed
 
 Output in RECORDINGS/PRESET/ (RECORDINGS: --recordings, $CROWNDEMO_RECORDINGS, else
 ./recordings): frames/frame_NNNNN.png (rendered offscreen with GGUI; needs a Vulkan driver,
-e.g. Debian's mesa-vulkan-drivers; --no-render skips it), video.mp4 and preview.gif (made
+e.g. Debian's mesa-vulkan-drivers; --no-render skips it; by default the liquid's surface,
+reconstructed from the particles each frame, --style particles draws spheres), video.mp4
+and preview.gif (made
 when the recording completes; an incomplete one gets video.partial.mp4), and
 snapshots/frame_NNNNN.npz (particles at t = 0 and every frame interval;
 fluid only unless --all-particles), checkpoint.npz (the full state, for --resume) and
@@ -90,9 +93,10 @@ def _option_words(options: dict) -> List[str]:
     else:
         if tuple(options["resolution"]) != tuple(d.resolution):
             words += ["--resolution", "%dx%d" % tuple(options["resolution"])]
-        if options.get("style", "particles") != d.style:
-            words += ["--style", options.get("style", "particles")]
-        if options["colour"] != RenderSettings(style=options.get("style", d.style)).colour:
+        style = options.get("style", "particles")     # recorded before --style: spheres
+        if style != d.style:
+            words += ["--style", style]
+        if options["colour"] != RenderSettings(style=style).colour:
             words += ["--colour", options["colour"]]
         if options["lang"] != d.lang:
             words += ["--lang", options["lang"]]
