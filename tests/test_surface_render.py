@@ -131,6 +131,11 @@ def test_quick_surface_frames(quick):
     lo, hi = view.geometry.frame_box()
     box = camera.project(pose, [[lo[0], 0, 0], [hi[0], 0, 0]], RES)
     assert np.ptp(px[:, 0]) > 0.5 * np.ptp(box[:, 0])
+    # play shows it: the headless reel holds every frame (no title card)
+    reel = folder.parent / "reel.mp4"
+    assert main(["play", "quick", "--recordings", str(folder.parent), "--headless", "--out",
+                 str(reel), "--card-seconds", "0", "--resolution", "%dx%d" % RES]) == 0
+    assert len(list(read_video(str(reel)))) == len(frames)
     # the surface's cost, beside the render's and the simulation's
     t = meta["render"]
     assert t["style"] == "surface" and 0 < t["surface_seconds"] < t["render_seconds"]
