@@ -8,7 +8,10 @@ One job per module:
 - ``colours``      colour fields (speed, height, pressure, milk), fixed scales, colour map;
 - ``buffers``      Taichi fields sized to capacity, filled by a kernel from the particle state;
 - ``floor``        the container floor mesh;
-- ``renderer``     Renderer: one GGUI window, spheres and floor, frame capture;
+- ``surface``      particles -> the liquid surface (pysplashsurf), mirrored for symmetry planes;
+- ``meshmeasure``  a mesh's area, volume, open edges, Euler characteristic, pieces;
+- ``meshbuffers``  the surface mesh's GGUI fields, with headroom;
+- ``renderer``     Renderer: one GGUI window, the surface or spheres, floor, frame capture;
 - ``captions``     Pillow text: frame captions, title cards, fonts (CJK where installed);
 - ``view``         a preset's camera, colours, sphere size and caption; RenderSettings;
 - ``video``        PNG, MP4 (H.264) and GIF files, written under temporary names;
