@@ -170,3 +170,27 @@ def test_style_options():
         "--style", "particles"]
     # a recording made before --style was drawn with spheres
     assert _option_words({**base, "colour": "speed"}) == ["--style", "particles"]
+
+
+@pytest.mark.parametrize("quality", ["draft", "booth", "seed"])
+def test_every_crown_preset_is_seen_from_low_with_its_crown_in_view(quality):
+    """The surface's camera for every 3D crown preset: 10 to 25 degrees above the film, and
+    the box the crown can fill by the end time (frame_box) inside the picture."""
+    from crowndemo.config.loader import preset_names
+    seen = 0
+    for name in preset_names():
+        r = config.load(name, quality)
+        if r.dim != 3:
+            continue
+        view = PresetView.from_resolved(r, RenderSettings())
+        _, _, elevation = camera.angles(view.start)
+        assert 10.0 <= elevation <= 25.0, name
+        lo, hi = view.geometry.frame_box()
+        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                            for z in (lo[2], hi[2])])
+        px = camera.project(view.start, corners, view.settings.resolution)
+        w, h = view.settings.resolution
+        assert (px[:, 0] >= 0).all() and (px[:, 0] <= w).all(), name
+        assert (px[:, 1] >= 0).all() and (px[:, 1] <= h).all(), name
+        seen += 1
+    assert seen >= 4
