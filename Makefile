@@ -6,7 +6,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 STAMP := $(VENV)/.crowndemo-installed
 
-.PHONY: setup vulkan fonts demo test validate bench device-wheels clean
+.PHONY: setup vulkan fonts demo test test-slow validate bench device-wheels clean
 
 setup: $(STAMP) vulkan fonts
 
@@ -64,7 +64,11 @@ demo: setup
 # One pytest-xdist worker per core (at most 4), each test file on one worker: most of the
 # suite's time is compiling kernels, one core per process, and a file's tests share them.
 test: setup
-	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile
+	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile -m "not slow"
+
+# The tests of minutes (pytest -m slow): the quarter crown against the whole run's quadrants.
+test-slow: setup
+	$(PY) -m pytest -q -m slow
 
 # The full validation suite (issue 5): every case at three resolutions and its settings
 # variants, the stability suite and the seed's crown verdicts; rewrites VALIDATION.md.

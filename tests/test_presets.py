@@ -106,8 +106,14 @@ def test_particle_classes_and_quick_is_quick():
     tp = estimate.throughput()
     booth = estimate.summary(config.load("3m-drop", "booth"), tp)["particles"]
     assert booth["exact"] and 250_000 < booth["fluid"] < 330_000       # the seed's 282,423
-    seed = estimate.summary(config.load("2.5m-drop", "seed"), tp)["particles"]
+    whole = ["quality.seed.symmetry=full", "quality.seed.trim_reach=2"]
+    seed = estimate.summary(config.load("2.5m-drop", "seed", whole), tp)["particles"]
     assert 10e6 < seed["fluid"] < 14e6                                 # the seed's 11,946,816
+    # the seed rung simulates a quarter (symmetry planes) of the film trimmed at 1.25 R_c:
+    # a quarter of the whole scene with that trim
+    trimmed = estimate.summary(config.load("2.5m-drop", "seed", whole[:1]), tp)["particles"]
+    quarter = estimate.summary(config.load("2.5m-drop", "seed"), tp)["particles"]
+    assert quarter["fluid"] == pytest.approx(trimmed["fluid"] / 4, rel=0.02)
     quick = estimate.summary(config.load("quick", "draft"), tp)
     assert quick["particles"]["fluid"] < 30_000 and quick["run_seconds"] < 60
 
@@ -463,7 +469,9 @@ def test_yaml_reads_exponent_floats_and_the_schema_covers_numerics(tmp_path):
     from crowndemo.config.yamlio import load_text
     assert load_text("a: 1e-3\nb: 2E5\nc: 7\nd: .inf\n", "x") == {
         "a": 1e-3, "b": 2e5, "c": 7, "d": math.inf}
-    assert set(schema.NUMERICS_KEYS) == {f.name for f in fields(Numerics)} - {"allow_unsafe_dt"}
+    # mirror_planes comes from scene.symmetry (the scene is built as the part), not numerics
+    assert set(schema.NUMERICS_KEYS) == {f.name for f in fields(Numerics)} - {
+        "allow_unsafe_dt", "mirror_planes"}
 
 
 def test_run_time_estimate_reads_the_tuned_rows_of_a_compare_table(tmp_path):

@@ -241,6 +241,12 @@ def _record(result, rows, stab, verd, paths) -> None:
         lines += ["## Stability suite", "", stability.markdown(stab), ""]
     if verd:
         lines += ["## The seed's observations: crown or not", "", verdicts.markdown(verd), ""]
+    lines += ["## Symmetry planes and trim", "",
+              "A half or quarter run with mirror planes against the whole scene (tank floor "
+              "pressure, dam-break front, the quarter crown against the whole run's "
+              "quadrants) and how far the impact disturbs the film (the trim): "
+              "[docs/symmetry.md](docs/symmetry.md) (`tools/symmetry_study.py`; "
+              "`tests/test_symmetry.py`).", ""]
     lines += ["## Regime map and interpretation", "",
               "The crown / no-crown regime map against Cossali et al.'s threshold is "
               "[docs/regime.md](docs/regime.md) (`crowndemo sweep --record`). What these "

@@ -147,6 +147,7 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
     layers = math.floor(h / r.l0 + 1e-9) / max(math.floor(h / l0c + 1e-9), 1)
     n_film = sc.info["n_film"] * k ** (d - 1) * layers
     n_drop = (math.pi / 6 * D ** 3 if d == 3 else math.pi / 4 * D ** 2) / r.l0 ** d
+    n_drop *= sc.info.get("simulated_fraction", 1.0)     # of a half or quarter run
     fluid = int(round(n_film + n_drop))
     area = k ** (d - 1)            # walls go with the floor area over l0^(d-1) ...
     if sc.info.get("trimmed"):     # ... of a disc (a strip in 2D) with a rim of layers x l0
@@ -164,14 +165,17 @@ def particle_counts(r: Resolved, exact_up_to: float = EXACT_UP_TO,
 def _rough_parts(r: Resolved) -> Dict:
     """Film, drop and wall-layer particles from the scene's sizes alone (volumes and floor
     area over l0^d), with the film's extent and whether it is trimmed."""
+    from ..core.symmetry import fraction
     from ..scenes.crown import reach_radius
     s, d, l0 = r.scene, r.dim, r.l0
     half = s["floor"] / 2
-    reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"])
+    reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"],
+                         s["trim_reach"])
     trimmed = s["trim"] and reach < half
     e = reach if trimmed else half
-    area = (math.pi * e * e) if d == 3 else 2 * e          # floor area (length in 2D)
-    drop = math.pi / 6 * s["drop"] ** 3 if d == 3 else math.pi / 4 * s["drop"] ** 2
+    part = fraction(r.numerics.mirror_planes)     # a half or quarter run (core/symmetry.py)
+    area = part * ((math.pi * e * e) if d == 3 else 2 * e)   # floor area (length in 2D)
+    drop = part * (math.pi / 6 * s["drop"] ** 3 if d == 3 else math.pi / 4 * s["drop"] ** 2)
     layers = math.ceil(s["re_ratio"])
     return {"film": area * s["film"] / l0 ** d, "drop": drop / l0 ** d,
             "walls": area / l0 ** (d - 1) * layers * (1.0 if trimmed else 1.5),

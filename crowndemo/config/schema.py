@@ -7,10 +7,11 @@ A preset (SI units throughout; lengths in m, times in s, speeds in m/s)::
     extends:     OTHER                     # optional; handled by the loader
     dim:         3                         # 3, or 2 for a cross-section (a cylinder-drop slice)
     scene:       {floor, film, drop, speed | height, gap, liquid, gravity, t_end,
-                  frame_interval, trim, re_ratio, sound_speed_factor, sound_speed}
+                  frame_interval, trim, re_ratio, sound_speed_factor, sound_speed,
+                  trim_reach, symmetry}
     numerics:    {courant, acoustic, ...}  # overrides of crowndemo.core.params.Numerics
     quality:     {draft: RUNG, booth: RUNG, seed: RUNG}
-    RUNG:        {l0, t_end, frame_interval, numerics}
+    RUNG:        {l0, t_end, frame_interval, symmetry, trim_reach, numerics}
 
 ``validate`` checks one value at a time (unknown key, type, missing value, range) and returns
 the document with defaults filled in; checks that relate several values live in ``resolve``.
@@ -23,6 +24,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, Iterable, Optional, Tuple
 
 from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, WALL_MODELS, WATER
+from ..core.symmetry import SYMMETRIES
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
 from .sound_speed import DEFAULT_FACTOR, FACTOR_RANGE
@@ -122,6 +124,13 @@ SCENE_KEYS = {
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
                   default=True),
     "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
+    "trim_reach": number("with trim: the film kept reaches this many times Yarin & Weiss's "
+                         "crown base radius at t_end (at least D), + 2 mm", "", 1, 10,
+                         lo_incl=True, default=2.0),
+    "symmetry": Field("choice", "the part simulated, with mirror planes through the drop's "
+                      "axis (core/symmetry.py): the whole scene, the half x > 0, or the quarter "
+                      "x > 0, y > 0 (3D); records, metrics and frames show the whole",
+                      choices=tuple(SYMMETRIES), default="full"),
     "sound_speed_factor": number("c / U: the artificial sound speed c is this many times "
                                  "the impact speed U (S8), or the fall or capillary speed of "
                                  "a slower drop (the seed's 5; config/sound_speed.py)", "",
@@ -173,6 +182,9 @@ RUNG_KEYS = {
     "l0": number("particle spacing", "m", 0, 0.01, required=True),
     "t_end": number("simulated time at this quality (replaces scene.t_end)", "s", 0, 10),
     "frame_interval": number("time between frames at this quality", "s", 0, 10),
+    "symmetry": Field("choice", "the part simulated at this quality (replaces scene.symmetry)",
+                      choices=tuple(SYMMETRIES)),
+    "trim_reach": number("scene.trim_reach at this quality", "", 1, 10, lo_incl=True),
     "numerics": Field("map", "numerics at this quality", keys=NUMERICS_KEYS),
 }
 RUNG = Field("map", "one quality rung", keys=RUNG_KEYS)

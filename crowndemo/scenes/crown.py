@@ -25,14 +25,21 @@ def crown_base_radius(t: float, U: float, D: float, h: float) -> float:
     return D * (2.0 / (3.0 * h / D)) ** 0.25 * math.sqrt(max(t, 0.0) * U / D)
 
 
-def reach_radius(t_end: float, U: float, D: float, h: float, gap: float) -> float:
-    """How far from the axis the liquid can be disturbed by t_end: twice the crown base radius
-    at the end time (the film ahead of the crown is pushed too), at least the drop, plus 2 mm.
+TRIM_REACH = 2.0     # the film kept: out to this many crown base radii at t_end (+ 2 mm)
+
+
+def reach_radius(t_end: float, U: float, D: float, h: float, gap: float,
+                 factor: float = TRIM_REACH) -> float:
+    """How far from the axis the liquid can be disturbed by t_end: ``factor`` (2) times the
+    crown base radius at the end time (the film ahead of the crown is pushed too), at least
+    the drop, plus 2 mm. (Measured in 2D at D/l0 = 100, U = 8 m/s, untrimmed: the film moving
+    faster than 1 m/s reached 1.4 R_c at 1 ms and 0.9-1.0 R_c at 3-4 ms, the rest of the film
+    jittering at 0.4-0.8 m/s; docs/symmetry.md.)
     Yarin & Weiss's radius grows without bound as h -> 0; a film thinner than D/10 (a dry floor
     included) is taken as D/10, which bounds a lamella spreading on a dry floor (r/D of about
     1.1 sqrt(t U / D), Rioboo et al. 2002) with a margin."""
     t_impact = gap / U
-    return max(2.0 * crown_base_radius(t_end - t_impact, U, D, max(h, 0.1 * D)), D) + 2.0e-3
+    return max(factor * crown_base_radius(t_end - t_impact, U, D, max(h, 0.1 * D)), D) + 2.0e-3
 
 
 def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 1.0e-2,
@@ -40,7 +47,7 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
           trim: bool = True, numerics: Optional[Numerics] = None, rho: float = WATER["rho"],
           nu: float = WATER["nu"], sigma: float = WATER["sigma"], gravity: float = GRAVITY,
           sound_speed: Optional[float] = None, re_ratio: float = 2.1,
-          symmetry: str = "full") -> Scene:
+          symmetry: str = "full", trim_reach: float = TRIM_REACH) -> Scene:
     """Drop on a film. ``floor`` is the side of the square container floor (the width of the
     slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0.
     ``symmetry``: the whole scene (full), or the part x > 0 (half), or x > 0, y > 0 (quarter,
@@ -50,7 +57,7 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     physics = Physics(dim=dim, l0=l0, v_max=speed, re_ratio=re_ratio, rho=rho, nu=nu,
                       sigma=sigma, gravity=gravity, sound_speed=sound_speed)
     half = floor / 2.0
-    reach = reach_radius(t_end, speed, drop, film, gap)
+    reach = reach_radius(t_end, speed, drop, film, gap, trim_reach)
     trimmed = trim and reach < half
     extent = reach if trimmed else half
     # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D)
