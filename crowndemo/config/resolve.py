@@ -16,6 +16,7 @@ from .loader import Document
 from .merge import DEFAULT_SOURCE
 from .schema import LIQUIDS, QUALITIES, SCENE_KEYS, dotted, validate
 from .sound_speed import FACTOR_RANGE, sound_speed
+from ..core.symmetry import planes_of
 
 if TYPE_CHECKING:
     from ..scenes.base import Scene
@@ -76,7 +77,8 @@ class Resolved:
                     gap=s["gap"], floor=s["floor"], t_end=s["t_end"], trim=s["trim"],
                     numerics=self.numerics, rho=self.liquid["rho"], nu=self.liquid["nu"],
                     sigma=self.liquid["sigma"], gravity=s["gravity"],
-                    sound_speed=s.get("sound_speed"), re_ratio=s["re_ratio"])
+                    sound_speed=s.get("sound_speed"), re_ratio=s["re_ratio"],
+                    symmetry=s["symmetry"], trim_reach=s["trim_reach"])
 
     def build_scene(self, l0: Optional[float] = None) -> Scene:
         """The particles (numpy only); ``l0`` builds the same scene at another spacing."""
@@ -158,7 +160,7 @@ def resolve(doc: Document, quality: str) -> Resolved:
     scene = dict(values["scene"])
     for k in scene:
         note(k, ("scene", k))
-    for k in ("t_end", "frame_interval"):
+    for k in ("t_end", "frame_interval", "symmetry", "trim_reach"):
         if k in rung and doc.rank_of(rpath + (k,)) >= doc.rank_of(("scene", k)):
             scene[k] = rung[k]
             note(k, rpath + (k,))
@@ -236,9 +238,16 @@ def resolve(doc: Document, quality: str) -> Resolved:
             where["sound_speed"] = where["sound_speed_factor"]
         derived = which if floor > scene["speed"] else "speed"
 
+    # symmetry planes through the drop's axis (core/symmetry.py): 2D has the plane x = 0 only
+    try:
+        planes = planes_of(scene["symmetry"], dim)
+    except ValueError:
+        fail("symmetry", scene["symmetry"], f"a {dim}D scene has {dim - 1} symmetry plane(s) "
+             "through the drop's axis", "full or half" + (" or quarter" if dim == 3 else ""))
+
     # the core's own checks (the schema's ranges make these pass; kept as a safety net)
     try:
-        numerics = Numerics(**num).validate()
+        numerics = Numerics(**num, mirror_planes=planes).validate()
     except ParameterError as e:
         fail("numerics." + e.key, e.value, "refused by the solver", e.allowed)
     physics_keys = {"l0": "l0", "v_max": "speed", "re_ratio": "re_ratio",
@@ -314,7 +323,7 @@ def slow_speed_floor(dim: int, l0: float, scene: dict, liquid: dict) -> Tuple[fl
     (2.25 sigma/l0 in 2D at re = 2.1 l0) the equation of state must balance inside the
     liquid. With c = 5 U alone a 0.5 m/s drop at l0 = 0.1 mm (c = 2.5 m/s) was compressed
     26 % by that stress and went unstable at its 6th step. No shipped preset reaches this
-    floor (tests/test_presets.py), so their c stays 5 U. Returns the larger and its name."""
+    floor (tests/test_presets.py), so their c stays k U. Returns the larger and its name."""
     from ..core.lattice import LatticeConstants, lattice_cohesion_pressure
     fall = math.sqrt(2.0 * scene["gravity"] * (scene["gap"] + scene["drop"]))
     capillary = 0.0
