@@ -71,6 +71,52 @@ def test_plan_covers_resolutions_and_variants():
     assert {v for _, v in p} == {"base", *c.variants}
 
 
+def test_quick_plan_keeps_every_case_with_one_variant():
+    """--quick: every case at its quick resolutions and in one of its own variants, at the
+    finest of them; between them every variant but the crown-only untrimmed film and
+    relative Courant limit (README, validate). The full plan keeps every variant."""
+    table = cases.all_cases(full=True)
+    seen = set()
+    for c in table.values():
+        p = plan(c, quick=True, variants=True)
+        assert [s for s, v in p if v == "base"] == list(c.quick)
+        others = [(s, v) for s, v in p if v != "base"]
+        if c.variants:
+            assert len(others) == 1 and others[0][1] in c.variants and others[0][0] == c.quick[-1]
+        else:
+            assert others == []
+        seen |= {v for _, v in others}
+        assert plan(c, quick=True, variants=False) == [(s, "base") for s in c.quick]
+        assert {v for _, v in plan(c, quick=False, variants=True)} == {"base", *c.variants}
+    every = {v for c in table.values() for v in c.variants}
+    assert every - seen == {"untrimmed", "relative-courant"}
+    assert set(cases.QUICK_VARIANT) == set(table) - {"crown-base-3m-drop"}
+
+
+def test_runs_of_one_model_share_a_compiled_simulator():
+    """Under cases.sharing, a second run of the same model compiles nothing and measures the
+    same decay (nu k^2 within the README's 0.35 % at lambda/l0 = 20, 2D), also a smaller scene
+    in the bigger simulator (1.6 % at lambda/l0 = 10); outside it each run gets its own."""
+    from crowndemo.control import Session, compiled_kernels
+    c = cases.all_cases(full=False)["shear-wave-2d"]
+    session = Session()
+    with cases.sharing(session):
+        first = run_one(c, 20)
+        before = compiled_kernels()
+        again = run_one(c, 20, "safety/2")        # other time-step safety numbers, same model
+        coarse = run_one(c, 10)                   # 400 particles in the 1,600's simulator
+        assert compiled_kernels() == before, "a later run compiled kernels"
+    assert session.constructions == 1 and len(session.events) == 3
+    assert all("reused" in e for e in session.events[1:])
+    for r in (first, again):
+        assert r.outcome == "ok" and r.error < 0.005
+    assert again.measured == pytest.approx(first.measured, rel=1e-3)
+    assert coarse.outcome == "ok" and coarse.error < 0.02
+    assert cases._shared is None                  # outside it: a new simulator per run
+    fresh = run_one(c, 10)
+    assert fresh.measured == pytest.approx(coarse.measured, rel=1e-4)
+
+
 # ---- quick reference cases --------------------------------------------------------------------
 def test_hydrostatic_case_within_5_percent():
     c = cases.all_cases(full=False)["hydrostatic-2d"]

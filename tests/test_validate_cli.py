@@ -31,7 +31,7 @@ def no_backend(monkeypatch):
 
 @pytest.fixture
 def fake_backend(monkeypatch):
-    be = types.SimpleNamespace(resolved="x64", precision="f32")
+    be = types.SimpleNamespace(resolved="x64", precision="f32", fast_compile=False)
     for mod in ("validate", "sweep"):
         monkeypatch.setattr(f"crowndemo.cli.{mod}.start_backend", lambda args: be)
 
@@ -92,6 +92,27 @@ def test_validate_runs_a_case_named_twice_once(tmp_path, ran, fake_backend):
             "--out", str(tmp_path)]
     assert main(argv) == 0
     assert ran["cases"] == [["laplace-2d", "hydrostatic-2d"]]
+
+
+def test_quick_compiles_fast_unless_the_environment_says(tmp_path, ran, monkeypatch):
+    """--quick asks the backend for the fast compile, unless $CROWNDEMO_FAST_COMPILE is set
+    (then the backend reads it); the report's header says which."""
+    asked = []
+
+    def start(args):
+        asked.append(args.fast_compile)
+        return types.SimpleNamespace(resolved="x64", precision="f32",
+                                     fast_compile=bool(args.fast_compile))
+    monkeypatch.setattr("crowndemo.cli.validate.start_backend", start)
+    monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
+    argv = ["validate", "hydrostatic-2d", "--out", str(tmp_path)]
+    assert main(argv + ["--quick"]) == 0
+    assert "x64, f32, fast compile; date" in (tmp_path / "validation.md").read_text()
+    assert main(argv) == 0
+    assert "x64, f32; date" in (tmp_path / "validation.md").read_text()
+    monkeypatch.setenv("CROWNDEMO_FAST_COMPILE", "0")
+    assert main(argv + ["--quick"]) == 0
+    assert asked == [True, None, None]
 
 
 def test_validate_json_is_strict(tmp_path, capsys, ran, fake_backend):

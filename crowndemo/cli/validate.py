@@ -15,7 +15,7 @@ INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finishe
 
 VALIDATE_EPILOG = """\
 examples:
-  crowndemo validate --quick                     # coarse resolutions, stability to 0.4 ms
+  crowndemo validate --quick                     # coarse resolutions, one variant each
   crowndemo validate                             # every case, every resolution and setting
   crowndemo validate dam-break-2d laplace-2d     # some cases
   crowndemo validate stability                   # the stiff and extreme cases only
@@ -28,13 +28,18 @@ Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-la
 at three resolutions in the base settings and, at the middle one, in its settings variants
 (--list says which case runs which):
   {variants}
+--quick runs each case at one coarse resolution and in one of its variants (--list names
+it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop and the verdicts unless
+named; it compiles as with --fast-compile (unless $CROWNDEMO_FAST_COMPILE says otherwise).
 Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
 matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
 validation.json (strict JSON: null for a value that is not a finite number). A run that
 measures cases replaces their report as a whole (an older plot it could not redraw is
 removed); stability.md and verdicts.md of earlier runs stay, headed by their own command.
 Ctrl-C writes the runs finished so far, marked as an interrupted run, and exits 130.
-Wall times exclude the first step of each run, which compiles the kernels (reported apart).
+Wall times exclude the first step of each run, which compiles the kernels (reported apart);
+runs of the same compiled model share one simulator where the scene fits in it, so only the
+first of them (and a bigger scene) compiles.
 """
 
 
@@ -74,7 +79,8 @@ def _list(table, extra, as_json: bool = False) -> int:
         print(strictjson.dumps({
             "cases": [{"name": c.name, "quantity": c.quantity, "reference": c.reference,
                        "resolution": c.resolution, "scales": list(c.scales),
-                       "quick": list(c.quick), "variants": list(c.variants)}
+                       "quick": list(c.quick), "quick_variants": list(c.quick_variants),
+                       "variants": list(c.variants)}
                       for c in table.values()],
             "groups": {"stability": list(stability.cases(True)),
                        "verdicts": list(verdicts.SEED)}}))
@@ -82,7 +88,8 @@ def _list(table, extra, as_json: bool = False) -> int:
     for c in table.values():
         print(f"{c.name:<22} {c.quantity}; reference: {c.reference}; {c.resolution} = "
               f"{', '.join(f'{s:g}' for s in c.scales)} (quick: "
-              f"{', '.join(f'{s:g}' for s in c.quick)}); variants: "
+              f"{', '.join(f'{s:g}' for s in c.quick)}"
+              f"{''.join(', variant ' + v for v in c.quick_variants)}); variants: "
               f"{', '.join(c.variants) or 'none'}")
     print(f"{'stability':<22} stiff and extreme drop-on-film cases: "
           f"{', '.join(stability.cases(True))}")
@@ -168,6 +175,8 @@ def _validate(args, argv) -> int:
     names = _names(args, table)
     out = os.path.join(repo_root(), "reports") if args.out is None else args.out
     require_folder("--out", out)
+    if args.quick and args.fast_compile is None and "CROWNDEMO_FAST_COMPILE" not in os.environ:
+        args.fast_compile = True        # a check, not a timing: compile in a third of the time
     be = start_backend(args)
 
     def say(text):
@@ -176,7 +185,8 @@ def _validate(args, argv) -> int:
 
     result = {"machine": machine_line(), "date": datetime.date.today().isoformat(),
               "command": " ".join([PROG] + [shlex.quote(a) for a in argv]),
-              "arch": be.resolved, "precision": be.precision, "quick": args.quick}
+              "arch": be.resolved, "precision": be.precision, "fast_compile": be.fast_compile,
+              "quick": args.quick}
     found = {"cases": [], "stability": [], "verdicts": []}
     interrupted = False
     try:
@@ -190,8 +200,9 @@ def _validate(args, argv) -> int:
     ran = {"cases": any(n in table for n in names), "stability": "stability" in names,
            "verdicts": "verdicts" in names}
     result.update({k: [r.as_dict() for r in found[k]] for k in found if ran[k]})
-    header = [f"Machine: {result['machine']}; arch {be.resolved}, {be.precision}; "
-              f"date {result['date']}.", "", f"Command: `{result['command']}`"]
+    header = [f"Machine: {result['machine']}; arch {be.resolved}, {be.precision}"
+              f"{', fast compile' if be.fast_compile else ''}; date {result['date']}.", "",
+              f"Command: `{result['command']}`"]
     if interrupted:
         header += ["", INTERRUPTED]
     paths = _write(out, header, rows, stab, verd, ran)
@@ -226,7 +237,8 @@ def _record(result, rows, stab, verd, paths) -> None:
     lines = ["# Validation", "",
              "Written by `crowndemo validate --record` (see the README's `validate` command "
              "and its Validation status); the numbers below are measured, not edited.", "",
-             f"- machine: {result['machine']}", f"- arch: {result['arch']}, {result['precision']}",
+             f"- machine: {result['machine']}", f"- arch: {result['arch']}, {result['precision']}"
+             f"{', fast compile' if result.get('fast_compile') else ''}",
              f"- date: {result['date']}", f"- command: `{result['command']}`", ""]
     if rows:
         lines += ["## Error against run time", ""]
@@ -267,8 +279,10 @@ def register(sub, common) -> None:
     p.add_argument("cases", nargs="*", metavar="CASE",
                    help="cases or groups to run (default: all; see --list)")
     p.add_argument("--quick", action="store_true",
-                   help="the coarse resolutions only, stability to 0.4 ms, no 3m-drop crown "
-                        "and no verdicts unless named")
+                   help="one coarse resolution and one settings variant per case (--list "
+                        "names it), stability to 0.4 ms, no 3m-drop crown and no verdicts "
+                        "unless named; compiles as with --fast-compile unless "
+                        "$CROWNDEMO_FAST_COMPILE is set")
     p.add_argument("--no-variants", action="store_true",
                    help="base settings only (no {variants})")
     add_quality(p, "draft", "quality of the verdict runs")

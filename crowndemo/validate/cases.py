@@ -6,12 +6,14 @@ error; the runner (``runner.py``) times it and varies the resolution and the set
 """
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field, replace
-from typing import Callable, Dict, List, Optional, Tuple
+from typing import Callable, Dict, Iterator, List, Optional, Tuple
 
 import numpy as np
 
+from ..control import Session
 from ..core import FLUID, Numerics, simulator_for
 from ..core.params import GRAVITY, WATER
 from ..scenes import (dam_break, hydrostatic_tank, momentum_deficit, shear_amplitude, shear_wave,
@@ -47,11 +49,53 @@ class Case:
     reference: str                 # where the reference comes from
     resolution: str                # how the spacing is given, e.g. "a/l0"
     scales: Tuple[float, ...]      # resolution values, coarse to fine (full suite)
-    quick: Tuple[float, ...]       # the subset for `--quick` and the tests
+    quick: Tuple[float, ...]       # the subset for `--quick` and the tests: one coarse scale
     l0_of: Callable[[float], float]
     run: Callable[[float, Numerics], Outcome]
     variants: Tuple[str, ...] = ("f64", "safety/2", "gradient=sum", "gradient=seed",
                                  "plane-floor")
+    quick_variant: str = ""        # the one variant `--quick` runs ("": the first)
+
+    @property
+    def quick_variants(self) -> Tuple[str, ...]:
+        """The variants of a quick plan: one, so that every case is checked in a changed
+        setting too (the full plan runs them all)."""
+        if not self.variants:
+            return ()
+        v = self.quick_variant or self.variants[0]
+        if v not in self.variants:
+            raise ValueError(f"{self.name}: quick variant {v!r} is not one of its variants "
+                             f"({', '.join(self.variants)})")
+        return (v,)
+
+
+# ---- compiled simulators shared between runs -----------------------------------------------
+_shared: Optional[Session] = None
+
+
+@contextlib.contextmanager
+def sharing(session: Optional[Session]) -> Iterator[Optional[Session]]:
+    """Within it the cases take their simulators from ``session`` (None: a new one per run).
+
+    A ``control.Session`` keeps one compiled simulator per model (what is compiled in:
+    dimension, terms, gradient form, floor), as for presets: a run whose model an earlier run
+    compiled reuses that simulator, reconfigured and reloaded, when the scene fits in it (on
+    one thread the same result bit for bit as a fresh simulator, tests/test_control.py; the
+    cell limit follows the scene's particles, and the step loops over the particles, not the
+    capacity), instead of compiling the kernels again (20-60 s for a 3D model on 2 cores); a
+    bigger scene gets a bigger simulator, compiled once. A session is valid while the backend
+    runs: a restart (another precision) needs a new one."""
+    global _shared
+    before, _shared = _shared, session
+    try:
+        yield session
+    finally:
+        _shared = before
+
+
+def simulator(scene):
+    """A simulator loaded with ``scene``: from the session of ``sharing``, else a new one."""
+    return _shared.load(scene) if _shared is not None else simulator_for(scene)
 
 
 # ---- hydrostatic pressure ------------------------------------------------------------------
@@ -75,7 +119,7 @@ def _hydrostatic(dim: int) -> Case:
         # hydrostatic answer does not depend on it
         scene = hydrostatic_tank(dim=dim, l0=l0, width=width, depth=depth, nu=1.0e-3,
                                  numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         # the column, started at zero pressure, still breathes by a few per cent at 0.25 s:
         # the profile averaged over 0.15-0.3 s (7 frames)
         fits: List[Tuple[float, float]] = []
@@ -87,7 +131,7 @@ def _hydrostatic(dim: int) -> Case:
 
     return Case(f"hydrostatic-{dim}d", dim, "floor pressure P(0) [Pa] from the fluid profile",
                 "rho g H (method.md §7)", "H/l0",
-                (20, 40, 80) if dim == 2 else (20, 30, 40), (20, 40) if dim == 2 else (20,),
+                (20, 40, 80) if dim == 2 else (20, 30, 40), (20,),
                 lambda s: depth / s, run)
 
 
@@ -116,7 +160,7 @@ def _dam_break(dim: int) -> Case:
 
     def run(l0: float, numerics: Numerics) -> Outcome:
         scene = dam_break(dim=dim, a=a, l0=l0, numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         grid, front = dam_break_fronts(sim, a, points[-1][0])
         T_ref = np.array([T for T, _ in points])
         Z_ref = np.array([Z for _, Z in points])
@@ -132,7 +176,7 @@ def _dam_break(dim: int) -> Case:
     return Case(f"dam-break-{dim}d", dim,
                 "surge front Z = z/a, worst point for T <= 3, time origin fitted (dT <= 0.4)",
                 "Martin & Moyce 1952 (method.md §7)", "a/l0",
-                (12.5, 25, 50) if dim == 2 else (8, 12, 16), (12.5, 25) if dim == 2 else (8,),
+                (12.5, 25, 50) if dim == 2 else (8, 12, 16), (12.5,) if dim == 2 else (8,),
                 lambda s: a / s, run)
 
 
@@ -143,7 +187,7 @@ def _oscillation(dim: int) -> Case:
     def run(l0: float, numerics: Numerics) -> Outcome:
         scene = oscillating_drop(dim=dim, radius=R, l0=l0, nu=nu, periods=periods,
                                  numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         ts, ss = [], []
 
         def sample(s, i):
@@ -158,7 +202,7 @@ def _oscillation(dim: int) -> Case:
 
     return Case(f"drop-oscillation-{dim}d", dim, "mode-2 angular frequency [rad/s]",
                 "Rayleigh-Lamb (method.md §7)", "R/l0",
-                (8, 12, 16) if dim == 2 else (5, 6, 8), (8, 12) if dim == 2 else (5,),
+                (8, 12, 16) if dim == 2 else (5, 6, 8), (8,) if dim == 2 else (5,),
                 lambda s: R / s, run,
                 variants=("f64", "safety/2", "gradient=sum", "gradient=seed"))   # no floor
 
@@ -172,7 +216,7 @@ def _laplace(dim: int) -> Case:
         numerics = replace(numerics, pressure_gradient="sum")
         scene = resting_drop(dim=dim, radius=R, l0=l0, nu=1.0e-4, t_end=0.02,
                              numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         virial: List[float] = []
         eos: List[float] = []
         lat, ph = sim.lattice, sim.physics
@@ -207,7 +251,7 @@ def _shear_wave(dim: int) -> Case:
 
     def run(l0: float, numerics: Numerics) -> Outcome:
         scene = shear_wave(dim=dim, wavelength=wavelength, l0=l0, numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         snap = sim.snapshot()
         a0 = shear_amplitude(snap["pos"], snap["vel"], wavelength, l0)
         sim.run(scene.t_end)
@@ -230,7 +274,7 @@ def _sliding_layer(dim: int) -> Case:
 
     def run(l0: float, numerics: Numerics) -> Outcome:
         scene = sliding_layer(dim=dim, delta=delta, l0=l0, numerics=numerics)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         sim.run(scene.t_end)
         snap, info = sim.snapshot(), scene.info
         deficit = momentum_deficit(snap["pos"], snap["vel"], snap["kind"], info["speed_m_s"],
@@ -263,7 +307,7 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
             kw["t_end"] = t_end
         from ..scenes import crown
         scene = crown(**kw)
-        sim = simulator_for(scene)
+        sim = simulator(scene)
         U, D, h, gap = kw["speed"], kw["drop"], kw["film"], kw["gap"]
         t_contact = gap / U
         frames = np.linspace(0, kw["t_end"], 9)[1:]
@@ -288,11 +332,27 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
                 lambda s: base.scene["drop"] / s, run, variants=variants)
 
 
+# The variant each case runs in `--quick`. Between them the quick set runs every variant of the
+# reference cases (f64 on small 2D cases: it restarts the backend, which compiles again); the
+# 3D cases take safety/2 where they have it, which changes no compiled term, so the run reuses
+# the base run's compiled simulator (a 3D model compiles in 20-50 s on 2 cores). Not in the
+# quick set: the crown's untrimmed film (11 times the particles) and its Courant limit on
+# relative speeds (another 3D model; the stability suite's -relative cases run it in 2D).
+QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
+                 "dam-break-2d": "gradient=sum", "dam-break-3d": "safety/2",
+                 "drop-oscillation-2d": "gradient=seed", "drop-oscillation-3d": "safety/2",
+                 "laplace-2d": "f64", "laplace-3d": "safety/2",
+                 "shear-wave-2d": "f64", "shear-wave-3d": "safety/2",
+                 "sliding-layer-2d": "plane-floor", "sliding-layer-3d": "plane-floor",
+                 "crown-base-quick": "safety/2"}
+
+
 def all_cases(full: bool = True) -> Dict[str, Case]:
     cases = [make(d) for make in (_hydrostatic, _dam_break, _oscillation, _laplace, _shear_wave,
                          _sliding_layer)
              for d in (2, 3)]
     cases.append(crown_case("quick"))
+    cases = [replace(c, quick_variant=QUICK_VARIANT.get(c.name, "")) for c in cases]
     if full:
         # the seed's first run, to 1 ms (the drafts' 2 ms at the finest spacing would take
         # most of an hour on 2 cores); its settings variants are those of crown-base-quick

@@ -9,7 +9,8 @@ from typing import Callable, Dict, Iterable, List, Optional
 
 from .. import backend
 from ..core import InstabilityError, Numerics
-from .cases import Case, variant_numerics
+from ..control import Session
+from .cases import Case, sharing, variant_numerics
 
 
 @dataclass
@@ -64,27 +65,33 @@ def variant_names(cases: Iterable[Case]) -> List[str]:
 
 def plan(case: Case, quick: bool, variants: bool) -> List[tuple]:
     """(scale, variant) pairs: every resolution in the base settings, and each variant at the
-    middle resolution (the finest of a quick plan)."""
+    middle resolution; a quick plan: the quick resolutions, and the case's one quick variant
+    at the finest of them."""
     scales = case.quick if quick else case.scales
     out = [(s, "base") for s in scales]
     if variants:
         mid = scales[len(scales) // 2] if not quick else scales[-1]
-        out += [(mid, v) for v in case.variants]
+        out += [(mid, v) for v in (case.quick_variants if quick else case.variants)]
     return out
 
 
 def run_suite(cases: Iterable[Case], quick: bool = False, variants: bool = True,
               on_row: Optional[Callable[[Row], None]] = None) -> List[Row]:
-    """Every case's plan; the f64 runs last, after one switch of the backend's precision."""
+    """Every case's plan; the f64 runs last, after one switch of the backend's precision.
+    Runs of the same compiled model share one simulator where the scene fits in it
+    (cases.sharing): only the first of them, and a bigger scene, compile the kernels."""
     be = backend.current()
     jobs = [(c, s, v) for c in cases for s, v in plan(c, quick, variants)]
     jobs.sort(key=lambda j: j[2] == "f64")
     rows: List[Row] = []
+    kernels = Session()
     for case, scale, variant in jobs:
         if variant == "f64" and backend.current().precision != "f64":
             backend.init(be.arch, "f64", be.seed, be.single_thread,
                          fast_compile=be.fast_compile)
-        row = run_one(case, scale, variant)
+            kernels = Session()             # the restart dropped every compiled simulator
+        with sharing(kernels):
+            row = run_one(case, scale, variant)
         rows.append(row)
         if on_row:
             on_row(row)

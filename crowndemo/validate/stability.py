@@ -17,7 +17,8 @@ from typing import Callable, Dict, List, Optional
 import numpy as np
 
 from ..core import GONE, InstabilityError, ParameterError, simulator_for
-from ..core.params import GRAVITY, WATER
+from ..core.params import GRAVITY, WATER, Model
+from ..control import Session
 from ..scenes import Scene, crown
 
 ENERGY_GROWTH = 0.02     # E_end > (1 + this) E_start with no source counts as growth
@@ -153,12 +154,16 @@ def cases(full: bool = False) -> Dict[str, StabilityCase]:
     return {x.name: x for x in c}
 
 
-def run_case(case: StabilityCase, t_end: float) -> StabilityRow:
+def run_case(case: StabilityCase, t_end: float,
+             session: Optional[Session] = None) -> StabilityRow:
+    """One case; its simulator from ``session`` when given (the compiled simulator of an
+    earlier case of the same model, when the scene fits in it: see cases.sharing), else a
+    new one."""
     t0 = time.perf_counter()
     scene = case.build(t_end)
     counts = scene.counts()
     try:
-        sim = simulator_for(scene)
+        sim = session.load(scene) if session is not None else simulator_for(scene)
     except ParameterError as e:
         return StabilityRow(case.name, case.kind, case.what, counts["total"], 0, t_end, 0.0,
                             time.perf_counter() - t0, math.nan, math.nan, {}, 0.0, 0.0,
@@ -195,8 +200,23 @@ def run_suite(names: Optional[List[str]] = None, full: bool = False,
     table = cases(full)
     t_end = 1.0e-3 if full else 4.0e-4
     rows = []
-    for name in names or list(table):
-        row = run_case(table[name], t_end)
+    names = names or list(table)
+    # the cases of one model share its compiled simulator, sized first for the largest of
+    # their scenes (the step's kernels compile at the first step, not here), so that no case
+    # needs a bigger one compiled again
+    session = Session()
+    largest: Dict[Model, Scene] = {}
+    for name in names:
+        sc = table[name].build(t_end)
+        if sc.numerics.fixed_dt is not None:      # refused before its run: never stepped
+            continue
+        model = Model.of(sc.physics, sc.numerics)
+        if model not in largest or len(sc.pos) > len(largest[model].pos):
+            largest[model] = sc
+    for sc in largest.values():
+        session.load(sc)
+    for name in names:
+        row = run_case(table[name], t_end, session)
         rows.append(row)
         if on_row:
             on_row(row)
