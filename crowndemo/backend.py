@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import atexit
+import contextlib
 import os
 import sys
 from dataclasses import dataclass
@@ -103,7 +104,11 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
                   log_level=ti.WARN if quiet else ti.INFO)
     if single_thread:
         kwargs["cpu_max_num_threads"] = 1
-    ti.init(arch=_arch_object(target), **kwargs)    # falls back to the CPU if CUDA fails
+    # ti.init prints "[Taichi] Starting on arch=..." on stdout, at every start (a restart for
+    # another precision too): it goes to stderr, so that stdout holds only what the command
+    # prints (one JSON document with --json)
+    with contextlib.redirect_stdout(sys.stderr):
+        ti.init(arch=_arch_object(target), **kwargs)    # falls back to the CPU if CUDA fails
     if arch in ("cuda", "vulkan", "gpu") and ti.lang.impl.current_cfg().arch in (ti.x64, ti.arm64):
         raise BackendError(f"arch {arch!r} was asked for but Taichi found no such device "
                            "(it fell back to the CPU); use --arch cpu")
