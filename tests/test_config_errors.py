@@ -103,7 +103,7 @@ def test_sources_of_a_preset_without_extends(tmp_path):
     r = config.load(str(path))
     assert r.where["speed"] == ("scene.speed", r.label)
     assert {k for k, (_, src) in r.where.items() if src == "default"} == {
-        "floor", "gap", "liquid", "gravity", "trim", "re_ratio",
+        "floor", "gap", "liquid", "gravity", "trim", "re_ratio", "symmetry", "trim_reach",
         "sound_speed_factor", "sound_speed"}     # c = k U from the default k
 
 
