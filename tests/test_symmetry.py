@@ -190,3 +190,19 @@ def test_quarter_crown_within_the_whole_runs_quadrant_spread():
     mean = quadrants.mean(axis=0)
     spread = np.abs(quadrants - mean).max(axis=0)
     assert np.all(np.abs(quarter - mean) <= spread), (quarter, quadrants)
+
+
+def test_particle_frames_draw_the_whole_of_a_quarter():
+    # the sphere style's buffers hold every fluid particle of a quarter run and its images
+    from crowndemo.render.buffers import ParticleBuffers
+    from crowndemo.render.colours import ColourScale
+    r = config.load("quick", "draft", ["scene.symmetry=quarter"])
+    sim = simulator_for(r.build_scene())
+    buf = ParticleBuffers(sim.state.capacity, sim.model.mirror_planes)
+    drawn = buf.fill(sim.state, ColourScale("height", 0.0, 1.0e-2))
+    whole = sim.whole_snapshot()
+    expected = whole["pos"][whole["kind"] == FLUID]
+    assert drawn == len(expected) == 4 * sim.counts()["fluid"]
+    got = buf.pos.to_numpy()[:drawn]
+    as_set = lambda p: {tuple(np.round(x / r.l0, 2)) for x in p}
+    assert as_set(got) == as_set(expected)

@@ -5,7 +5,7 @@ each frame as an RGB image."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Optional, Tuple
+from typing import TYPE_CHECKING, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -52,9 +52,10 @@ class Renderer:
         self.mesh_buffers: Optional[MeshBuffers] = None
         self.drawn = 0                       # particles (triangles) drawn in the last frame
 
-    def _buffers_for(self, capacity: int) -> ParticleBuffers:
-        if self.buffers is None or self.buffers.capacity < capacity:
-            self.buffers = ParticleBuffers(capacity)
+    def _buffers_for(self, capacity: int, planes: Sequence[int] = ()) -> ParticleBuffers:
+        if (self.buffers is None or self.buffers.capacity < capacity
+                or self.buffers.planes != tuple(planes)):
+            self.buffers = ParticleBuffers(capacity, planes)
         return self.buffers
 
     def _set_camera(self, pose: Pose) -> float:
@@ -70,8 +71,9 @@ class Renderer:
         return dist
 
     def draw(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
-             floor: Optional[FloorMesh] = None) -> None:
-        """Submit one frame: the fluid of ``state`` as spheres of world ``radius``."""
+             floor: Optional[FloorMesh] = None, planes: Sequence[int] = ()) -> None:
+        """Submit one frame: the fluid of ``state`` as spheres of world ``radius``; with
+        symmetry ``planes`` (axes) mirrored into the whole."""
         scene = self.scene
         dist = self._set_camera(pose)
         scene.ambient_light(AMBIENT)
@@ -80,7 +82,7 @@ class Renderer:
                                 + 0.3 * (eye - target)), LIGHT)
         if floor is not None:
             floor.draw(scene)
-        buf = self._buffers_for(state.capacity)
+        buf = self._buffers_for(state.capacity, planes)
         self.drawn = buf.fill(state, scale)
         if self.drawn:
             w, h = self.resolution
@@ -121,8 +123,8 @@ class Renderer:
         return (np.clip(rgb, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
 
     def render(self, state: ParticleState, pose: Pose, scale: ColourScale, radius: float,
-               floor: Optional[FloorMesh] = None) -> np.ndarray:
-        self.draw(state, pose, scale, radius, floor)
+               floor: Optional[FloorMesh] = None, planes: Sequence[int] = ()) -> np.ndarray:
+        self.draw(state, pose, scale, radius, floor, planes)
         return self.capture()
 
     def close(self) -> None:

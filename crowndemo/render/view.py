@@ -13,7 +13,7 @@ from . import camera
 from .captions import CaptionInfo, draw_caption
 from .colours import DEFAULT_MODE, ColourScale, vertex_colours
 from .renderer import DEFAULT_RESOLUTION
-from .surface import SurfaceMesh, SurfaceParams, fluid_of, reconstruct
+from .surface import SurfaceMesh, SurfaceParams, fluid_of, plane_axes, reconstruct
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -106,7 +106,8 @@ class PresetView:
             pos, fields = fluid_of(state)
             img = self.surface_image(renderer, pos, fields, pose)
         else:
-            img = renderer.render(state, pose, self.scale, self.radius, self.floor)
+            img = renderer.render(state, pose, self.scale, self.radius, self.floor,
+                                  plane_axes(self.planes))
         return draw_caption(img, self.caption, time, self.settings.lang, self.marker,
                             self.scale)
 
