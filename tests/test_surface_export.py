@@ -88,3 +88,24 @@ def test_export_surface_of_a_recording(tmp_path):
         assert poly.GetPointData().GetArray("speed") is not None
         z = vtk_to_numpy(poly.GetPoints().GetData())[:, 2]
         assert np.allclose(vtk_to_numpy(poly.GetPointData().GetArray("height")), z, atol=1e-9)
+
+
+def test_export_surface_of_a_quarter_run_is_the_whole(tmp_path):
+    """quick as a quarter (symmetry planes x = 0, y = 0; metadata.json says so): the exported
+    surface covers all four quadrants, mirror-symmetric, and is closed (no seam at the
+    planes)."""
+    root = tmp_path / "rec"
+    assert main(["record", "quick", "--recordings", str(root), "--no-render", "--quiet",
+                 "--set", "scene.symmetry=quarter", "--set", "scene.t_end=2.5e-4",
+                 "--fast-compile"]) == 0
+    meta = json.loads((root / "quick" / "metadata.json").read_text())
+    assert surface_vtk.planes_of(meta) == ["x", "y"]
+    assert main(["export", "quick", "--recordings", str(root), "--surface", "--quiet"]) == 0
+    out = root / "quick" / "vtk"
+    for _, name in read_pvd(out / "quick-surface.pvd"):
+        poly = read_vtp(out / name)
+        v = vtk_to_numpy(poly.GetPoints().GetData())
+        tris = vtk_to_numpy(poly.GetPolys().GetConnectivityArray()).reshape(-1, 3)
+        assert v[:, 0].min() == pytest.approx(-v[:, 0].max())
+        assert v[:, 1].min() == pytest.approx(-v[:, 1].max())
+        assert mm.open_edges(tris) == 0
