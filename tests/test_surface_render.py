@@ -194,3 +194,23 @@ def test_every_crown_preset_is_seen_from_low_with_its_crown_in_view(quality):
         assert (px[:, 1] >= 0).all() and (px[:, 1] <= h).all(), name
         seen += 1
     assert seen >= 4
+
+
+def test_the_dish_has_a_low_rim():
+    """The surface's floor with its rim: the floor at the wall face (z = -l0/2) over the whole
+    square, and four side walls on its edges rising h + D above it, each with its own normal
+    (horizontal, across the wall)."""
+    window.check_available()
+    from crowndemo.render.floor import FloorMesh
+    r = config.load("quick", "draft")
+    g = PresetView.from_resolved(r, RenderSettings()).geometry
+    mesh = FloorMesh(g, rim=True)
+    v, n = mesh.vertices.to_numpy(), mesh.normals.to_numpy()
+    half, z = g.floor / 2, -0.5 * g.l0
+    assert len(v) == 4 * 5 and len(mesh.indices_np) == 6 * 5
+    assert np.allclose(v[:4, 2], z) and np.allclose(np.abs(v[:4, :2]), half)
+    walls, wn = v[4:], n[4:]
+    assert np.allclose(np.abs(walls[:, :2]).max(axis=1), half, rtol=1e-6)
+    assert np.isclose(walls[:, 2].max(), z + g.film + g.drop, rtol=1e-6)
+    assert np.allclose(wn[:, 2], 0.0, atol=1e-6) and np.allclose(np.linalg.norm(wn, axis=1), 1)
+    assert len(FloorMesh(g).corners) == 4                          # spheres: the floor alone

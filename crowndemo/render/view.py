@@ -94,7 +94,7 @@ class PresetView:
         if self._floor is None:                     # Taichi fields: made on first use
             from .floor import FloorMesh, SURFACE_FLOOR
             surface = self.settings.style == "surface"
-            self._floor = (FloorMesh(self.geometry, SURFACE_FLOOR) if surface
+            self._floor = (FloorMesh(self.geometry, SURFACE_FLOOR, rim=True) if surface
                            else FloorMesh(self.geometry))
         return self._floor
 
