@@ -8,7 +8,7 @@ from crowndemo import config
 from crowndemo.config import estimate
 
 MEASURED = [
-    # (preset, --set overrides, steps measured to t_end)
+    # (preset, --set overrides, steps measured to t_end), at the draft quality
     # python -m crowndemo.validate.sound_speed run --dim 2 --l0 1e-4 --factor 10 --out F
     # (3m-drop in 2D at D/l0 = 100, c = 10 U = the default; frames every 0.1 ms and at
     # contact, as the draft's every 0.1 ms): 1,955 steps to 2 ms
@@ -20,6 +20,9 @@ MEASURED = [
     # U = 6.26 m/s, c = 10 U, 20 frames): 410 steps to 2 ms
     ("2m-drop", [], 410),
 ]
+# python -m crowndemo run 3m-drop --quality booth --json (3D, D/l0 = 33, c = 10 U, 4 ms):
+# 1,128 steps
+BOOTH_3M_DROP_STEPS = 1128
 
 
 @pytest.mark.parametrize("preset,sets,measured", MEASURED)
@@ -27,3 +30,8 @@ def test_steps_to_end_within_a_quarter_of_a_measured_run(preset, sets, measured)
     r = config.load(preset, "draft", sets)
     est = estimate.steps_to_end(r)["steps"]
     assert abs(est / measured - 1) <= 0.25, (est, measured)
+
+
+def test_booth_steps_within_a_quarter_of_the_measured_run():
+    est = estimate.steps_to_end(config.load("3m-drop", "booth"))["steps"]
+    assert abs(est / BOOTH_3M_DROP_STEPS - 1) <= 0.25, est
