@@ -261,3 +261,15 @@ def test_sweep_ctrl_c_writes_the_points_that_ran(tmp_path, swept, fake_backend):
     data = _strict((tmp_path / "regime.json").read_text())
     assert data["interrupted"] is True and len(data["points"]) == 1
     assert data["points_planned"] == 2
+
+
+def test_record_keeps_the_sections_other_commands_write():
+    # validate --record rewrites VALIDATION.md; the sound-speed study's sections, which its own
+    # command writes, come through (each to the next '## ' heading), its own sections do not
+    from crowndemo.cli.validate import kept_sections
+    old = ("# Validation\n\n## Stability suite\n\nold table\n\n## Sound speed\n\nstudy\n\n"
+           "## Sound speed: the rule chosen\n\nwhy\n")
+    new = ["# Validation", "", "## Stability suite", "", "new table", ""]
+    assert kept_sections(old, new) == ["## Sound speed", "", "study", "",
+                                       "## Sound speed: the rule chosen", "", "why", ""]
+    assert kept_sections("# Validation\n\n## Stability suite\n\nx\n", new) == []

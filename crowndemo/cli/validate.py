@@ -6,6 +6,7 @@ import datetime
 import os
 import shlex
 import sys
+from typing import List
 
 from .common import (EXIT_FAILED, EXIT_INTERRUPTED, PROG, Fmt, UsageError, add_quality,
                      path_argument, repo_root, require_folder, start_backend)
@@ -264,8 +265,27 @@ def _record(result, rows, stab, verd, paths) -> None:
               "[docs/regime.md](docs/regime.md) (`crowndemo sweep --record`). What these "
               "numbers mean, and where they fall short, is discussed in the README's "
               "*Validation status*.", ""]
-    with open(os.path.join(root, "VALIDATION.md"), "w") as f:
+    path = os.path.join(root, "VALIDATION.md")
+    if os.path.isfile(path):        # sections other commands write (the sound-speed study)
+        with open(path, encoding="utf-8") as f:
+            lines += kept_sections(f.read(), lines)
+    with open(path, "w") as f:
         f.write("\n".join(lines))
+
+
+def kept_sections(old: str, new_lines: List[str]) -> List[str]:
+    """The '## ' sections of the old VALIDATION.md whose headings the new lines do not have:
+    those that other commands write (`python -m crowndemo.validate.sound_speed table FILE
+    --record`), kept through a rewrite, each to the next '## ' heading."""
+    written = {line for line in new_lines if line.startswith("## ")}
+    out: List[str] = []
+    keep = False
+    for line in old.splitlines():
+        if line.startswith("## "):
+            keep = line not in written
+        if keep:
+            out.append(line)
+    return out + ([""] if out and out[-1] != "" else [])
 
 
 def register(sub, common) -> None:
