@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
 
 from ..core import timestep
 from ..core.health import starts_too_fast
-from ..core.params import SOUND_SPEED_FACTOR, Model, Numerics, ParameterError, Physics
+from ..core.params import Model, Numerics, ParameterError, Physics
 from .errors import MISSING, PresetError
 from .loader import Document
 from .merge import DEFAULT_SOURCE

@@ -19,7 +19,6 @@ so the state is the same and no particle is ever on the far side.
 renderer, the crown metrics and the exports.
 """
 
-import itertools
 import math
 from typing import Dict, Sequence, Tuple
 

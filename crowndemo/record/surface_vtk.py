@@ -13,12 +13,11 @@ import shutil
 import tempfile
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
-from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from .files import PathLike, atomic_write
-from .vtk import VTK_TYPES, _first_missing, write_pvd
+from .files import PathLike
+from .vtk import _first_missing, appended, write_appended, write_pvd
 
 PREFIX = "surface_"
 
@@ -43,15 +42,7 @@ def write(path: PathLike, mesh, time: Optional[float] = None) -> None:
     blocks.append(("Points", "Points", 3, mesh.vertices.astype(np.float64)))
     blocks.append(("Polys", "connectivity", 1, mesh.triangles.astype(np.int64).reshape(-1)))
     blocks.append(("Polys", "offsets", 1, 3 * np.arange(1, nt + 1, dtype=np.int64)))
-    offset, payload, arrays = 0, [], {"PointData": [], "Points": [], "Polys": []}
-    for section, name, comps, a in blocks:
-        a = np.ascontiguousarray(a)
-        raw = a.astype(a.dtype.newbyteorder("<"), copy=False).tobytes()
-        arrays[section].append(
-            f'        <DataArray type="{VTK_TYPES[a.dtype]}" Name={quoteattr(name)} '
-            f'NumberOfComponents="{comps}" format="appended" offset="{offset}"/>')
-        payload += [np.uint64(len(raw)).tobytes(), raw]
-        offset += 8 + len(raw)
+    arrays, payload = appended(blocks)
     field = ("" if time is None else
              '    <FieldData>\n      <DataArray type="Float64" Name="TimeValue" '
              f'NumberOfTuples="1" format="ascii">{float(time)!r}</DataArray>\n    </FieldData>\n')
@@ -66,14 +57,7 @@ def write(path: PathLike, mesh, time: Optional[float] = None) -> None:
             + "\n".join(arrays["Points"]) + "\n      </Points>\n      <Polys>\n"
             + "\n".join(arrays["Polys"]) + "\n      </Polys>\n    </Piece>\n  </PolyData>\n"
             '  <AppendedData encoding="raw">\n   _')
-    tail = "\n  </AppendedData>\n</VTKFile>\n"
-
-    def emit(f):
-        f.write(head.encode())
-        for b in payload:
-            f.write(b)
-        f.write(tail.encode())
-    atomic_write(path, emit)
+    write_appended(path, head, payload)
 
 
 def surface_of(snap: Dict[str, np.ndarray], l0: float, planes: Sequence[str] = ()):

@@ -50,14 +50,7 @@ def write(path: PathLike, snap: Dict[str, np.ndarray], time: float = None) -> No
     blocks.append(("Verts", "connectivity", 1, np.arange(n, dtype=np.int64)))
     blocks.append(("Verts", "offsets", 1, np.arange(1, n + 1, dtype=np.int64)))
 
-    offset, payload, arrays = 0, [], {"PointData": [], "Points": [], "Verts": []}
-    for section, name, comps, a in blocks:
-        raw = a.astype(a.dtype.newbyteorder("<"), copy=False).tobytes()
-        arrays[section].append(
-            f'        <DataArray type="{VTK_TYPES[a.dtype]}" Name={quoteattr(name)} '
-            f'NumberOfComponents="{comps}" format="appended" offset="{offset}"/>')
-        payload += [np.uint64(len(raw)).tobytes(), raw]
-        offset += 8 + len(raw)
+    arrays, payload = appended(blocks)
     fields = [] if time is None else [
         '      <DataArray type="Float64" Name="TimeValue" NumberOfTuples="1" '
         f'format="ascii">{float(time)!r}</DataArray>']
@@ -77,13 +70,32 @@ def write(path: PathLike, snap: Dict[str, np.ndarray], time: float = None) -> No
             + "\n".join(arrays["Points"]) + "\n      </Points>\n      <Verts>\n"
             + "\n".join(arrays["Verts"]) + "\n      </Verts>\n    </Piece>\n  </PolyData>\n"
             '  <AppendedData encoding="raw">\n   _')
-    tail = "\n  </AppendedData>\n</VTKFile>\n"
+    write_appended(path, head, payload)
 
+
+def appended(blocks: Sequence[Tuple[str, str, int, np.ndarray]]
+             ) -> Tuple[Dict[str, List[str]], List[bytes]]:
+    """Blocks (section, name, components, data) as raw appended data: the DataArray lines of
+    each section and the payload (UInt64 byte count, then the little-endian bytes, each)."""
+    offset, payload, arrays = 0, [], {}
+    for section, name, comps, a in blocks:
+        a = np.ascontiguousarray(a)
+        raw = a.astype(a.dtype.newbyteorder("<"), copy=False).tobytes()
+        arrays.setdefault(section, []).append(
+            f'        <DataArray type="{VTK_TYPES[a.dtype]}" Name={quoteattr(name)} '
+            f'NumberOfComponents="{comps}" format="appended" offset="{offset}"/>')
+        payload += [np.uint64(len(raw)).tobytes(), raw]
+        offset += 8 + len(raw)
+    return arrays, payload
+
+
+def write_appended(path: PathLike, head: str, payload: Sequence[bytes]) -> None:
+    """A VTK XML file (atomically): ``head`` up to the appended data's '_', the payload."""
     def emit(f):
         f.write(head.encode())
         for b in payload:
             f.write(b)
-        f.write(tail.encode())
+        f.write("\n  </AppendedData>\n</VTKFile>\n".encode())
     atomic_write(path, emit)
 
 
