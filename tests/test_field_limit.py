@@ -67,9 +67,14 @@ def test_preset_too_fine_for_one_simulator_is_refused_on_its_l0_key():
     assert need > 4e-4 and (limit + 1000) * (4e-4 / need) ** 3 <= limit
 
 
+# the seed rung as the whole scene with the default trim (it simulates a trimmed quarter)
+WHOLE = ("quality.seed.symmetry=full", "quality.seed.trim_reach=2")
+
+
 def test_preset_far_too_fine_is_refused_before_its_scene_is_built():
-    # the thick layer at l0 = 40 um: ~370 M particles, which numpy would take minutes to build
-    r = config.load("thick-layer", "seed", ["quality.seed.l0=4e-5"])
+    # the whole thick layer at l0 = 40 um (the seed rung simulates a quarter; here the whole):
+    # ~370 M particles, which numpy would take minutes to build
+    r = config.load("thick-layer", "seed", ["quality.seed.l0=4e-5", *WHOLE])
     with pytest.raises(PresetError, match=r"about [\d,]+ particles") as e:
         r.build_scene()
     assert e.value.key == "quality.seed.l0"
@@ -78,7 +83,7 @@ def test_preset_far_too_fine_is_refused_before_its_scene_is_built():
 def test_info_says_when_a_preset_is_too_large(capsys):
     from crowndemo.cli import main
     assert main(["info", "thick-layer", "--quality", "seed", "--set",
-                 "quality.seed.l0=8e-5"]) == 0
+                 "quality.seed.l0=8e-5", *(a for w in WHOLE for a in ("--set", w))]) == 0
     out = capsys.readouterr().out
     assert "too many" in out and "a run would be refused" in out
     assert main(["info", "thick-layer", "--quality", "seed", "--json"]) == 0
