@@ -8,16 +8,13 @@ into the whole scene.
 """
 from __future__ import annotations
 
-import os
-import shutil
-import tempfile
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
 from .files import PathLike
-from .vtk import _first_missing, appended, write_appended, write_pvd
+from .vtk import all_or_nothing, appended, write_appended, write_pvd
 
 PREFIX = "surface_"
 
@@ -80,12 +77,11 @@ def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str, l0:
     from .snapshots import read as read_snapshot
 
     out = Path(out_dir)
-    made = _first_missing(out)
-    out.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=".export.", dir=out))
     seconds = 0.0
-    try:
-        entries = []
+    entries: List[Tuple[float, str]] = []
+
+    def write_into(tmp: Path) -> List[str]:
+        nonlocal seconds
         for f in snapshot_files:
             snap = read_snapshot(f)
             start = _time.perf_counter()
@@ -94,17 +90,10 @@ def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str, l0:
             vtp = PREFIX + Path(f).stem.replace("frame_", "") + ".vtp"
             write(tmp / vtp, mesh, snap["time"])
             entries.append((snap["time"], vtp))
-        pvd = f"{name}-surface.pvd"
-        write_pvd(tmp / pvd, entries)
-        for _, n in entries:
-            os.replace(tmp / n, out / n)
-        os.replace(tmp / pvd, out / pvd)
-    except BaseException:
-        if made is not None:
-            shutil.rmtree(made, ignore_errors=True)
-        raise
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+        write_pvd(tmp / f"{name}-surface.pvd", entries)
+        return [n for _, n in entries] + [f"{name}-surface.pvd"]
+
+    pvd = all_or_nothing(out, write_into)[-1]
     keep = {n for _, n in entries}
     for old in out.glob(PREFIX + "*.vtp"):
         if old.name not in keep:

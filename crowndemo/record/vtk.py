@@ -15,7 +15,7 @@ import shutil
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
-from typing import Dict, List, Sequence, Tuple
+from typing import Callable, Dict, List, Sequence, Tuple
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
@@ -148,11 +148,19 @@ def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str) -> 
     into place (the .pvd last) once every frame is written, so a damaged snapshot
     (snapshots.SnapshotError) or a full disk leaves ``out_dir`` as it was, or absent."""
     out = Path(out_dir)
+    names = all_or_nothing(out, lambda tmp: _write_all(snapshot_files, tmp, name))
+    return out / names[-1]
+
+
+def all_or_nothing(out: Path, write_into: Callable[[Path], List[str]]) -> List[str]:
+    """``write_into(folder)`` writes files into a temporary folder inside ``out`` and returns
+    their names; they are moved into ``out`` in that order once all are written. On any
+    failure ``out`` is left as it was (or removed, if this call made it). Returns the names."""
     made = _first_missing(out)
     out.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=".export.", dir=out))
     try:
-        names = _write_all(snapshot_files, tmp, name)
+        names = write_into(tmp)
         for n in names:
             os.replace(tmp / n, out / n)
     except BaseException:
@@ -161,7 +169,7 @@ def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str) -> 
         raise
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
-    return out / names[-1]
+    return names
 
 
 def _write_all(snapshot_files: Sequence[PathLike], folder: Path, name: str) -> List[str]:
