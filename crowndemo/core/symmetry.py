@@ -56,7 +56,7 @@ def fraction(planes: Sequence[int]) -> float:
     return 0.5 ** len(tuple(planes))
 
 
-def _masks(planes: Sequence[int]):
+def plane_sets(planes: Sequence[int]):
     """The non-empty sets of planes an image is reflected across, as tuples of axes."""
     planes = tuple(planes)
     return [tuple(a for b, a in enumerate(planes) if m >> b & 1)
@@ -66,7 +66,8 @@ def _masks(planes: Sequence[int]):
 def images_of(pos: np.ndarray, planes: Sequence[int], reach: float) -> int:
     """How many mirror images the particles at ``pos`` have within ``reach`` of the planes."""
     pos = np.asarray(pos, dtype=float)
-    return int(sum(np.all(pos[:, list(axes)] < reach, axis=1).sum() for axes in _masks(planes)))
+    return int(sum(np.all(pos[:, list(axes)] < reach, axis=1).sum()
+                   for axes in plane_sets(planes)))
 
 
 IMAGE_ROOM = 3.0            # images allowed for, times those of the initial state
@@ -90,7 +91,7 @@ def mirror_whole(snapshot: Dict[str, np.ndarray], planes: Sequence[int],
     if not planes:
         return snapshot
     out = {name: [np.asarray(a)] for name, a in snapshot.items()}
-    for axes in _masks(planes):
+    for axes in plane_sets(planes):
         for name, a in snapshot.items():
             a = np.array(a, copy=True)
             if name in vectors:
@@ -129,7 +130,7 @@ class Symmetry:
         if not self.planes or any(not 0 <= a < state.dim - 1 for a in self.planes):
             raise ValueError(f"symmetry planes {self.planes}: axes 0 .. {state.dim - 2}")
         self.masks = [sum(1 << b for b, a in enumerate(self.planes) if a in axes)
-                      for axes in _masks(self.planes)]
+                      for axes in plane_sets(self.planes)]
         self.source = ti.field(ti.i32, state.capacity)    # per image slot: its particle
         self.mask = ti.field(ti.i32, state.capacity)      # per image slot: bit b = plane b
         self.wanted = ti.field(ti.i32, shape=())          # images the last build asked for
@@ -225,4 +226,4 @@ class Symmetry:
 
 
 __all__ = ["Symmetry", "SYMMETRIES", "planes_of", "plane_names", "symmetry_name", "fraction",
-           "mirror_whole", "cut", "images_of", "image_room"]
+           "mirror_whole", "cut", "images_of", "image_room", "plane_sets"]

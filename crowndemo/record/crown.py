@@ -29,9 +29,9 @@ class CrownSink:
         self.log = log
 
     def frame(self, sim: Simulator, index: int, time: float) -> None:
-        snap = sim.whole_snapshot()         # a half or quarter run mirrored (symmetry.py)
+        snap = sim.snapshot()               # a half or quarter run: measured as the whole
         m = measure(snap["pos"][snap["kind"] == FLUID], time, self.film, self.drop, self.l0,
-                    edge=self.edge)
+                    edge=self.edge, planes=sim.model.mirror_planes)
         for entry in reversed(self.log.frames):
             if entry["index"] == index:
                 entry["crown"] = finite_or_none(m.as_dict())

@@ -15,6 +15,9 @@ The rules, each a few lines below:
   the film is an ejected droplet;
 - base radius: per azimuthal sector, the outermost raised particle of the main body in the
   root band h + 2 l0 < z < h + 5 l0 (the foot of the crown wall), the median over sectors;
+  the foot is the part of the band continuous (radial gaps of at most 2 l0) with the wall
+  standing just above it (h + 5 l0 to h + 8 l0): spray that landed on the film beyond the
+  crown is linked to the body through the film, but it is not the crown's foot;
 - rim height: in azimuthal bins of about 2 l0 of arc (the two sides in 2D), the highest
   particle of the main body outside half the base radius, above h; the median over bins (the
   rim between the fingers when fingers are narrow);
@@ -33,14 +36,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
-from typing import Optional
+from typing import Optional, Sequence, Tuple
 
 import numpy as np
 
-from .clusters import groups
+from ..core.symmetry import mirror_whole
+from .clusters import whole_groups
 
 RAISED_L0 = 2.0        # raised liquid: more than this many l0 above the film surface
 ROOT_TOP_L0 = 5.0      # the root band of the crown wall ends this many l0 above the surface
+ABOVE_TOP_L0 = 8.0     # the wall just above the root band: up to this many l0 above it
+FOOT_GAP_L0 = 2.0      # a radial gap wider than this parts the foot from liquid beyond it
 LINK_L0 = 1.5          # particles closer than this many l0 belong to one body
 COHERENCE_LINK_L0 = 1.6   # the sheet-coherence link (issue 21's definition)
 JET_PROMINENCE_L0 = 2.0
@@ -85,6 +91,30 @@ def _per_sector(values: np.ndarray, sector: np.ndarray, n: int, fn) -> np.ndarra
     return out
 
 
+def _segments(r: np.ndarray, gap: float) -> Tuple[np.ndarray, np.ndarray]:
+    """The sorted ``r`` cut where consecutive values lie more than ``gap`` apart: the first and
+    last value of each segment."""
+    rs = np.sort(r)
+    cut = np.flatnonzero(np.diff(rs) > gap)
+    return rs[np.r_[0, cut + 1]], rs[np.r_[cut, len(rs) - 1]]
+
+
+def _foot(r_root: np.ndarray, r_above: np.ndarray, gap: float) -> float:
+    """The outer end of the crown wall's foot in one sector: of the radial segments of the
+    root band (``r_root``), those within ``gap`` of the wall just above the band (the largest
+    segment of ``r_above``); the outermost root particle when nothing stands above the band.
+    Liquid that has landed on the film beyond the crown (a bump linked to the film) stands in
+    the root band but not above it, apart from the foot: it is not the base."""
+    if len(r_above) == 0:
+        return float(r_root.max())
+    lo_a, hi_a = _segments(r_above, gap)
+    counts = [np.count_nonzero((r_above >= a) & (r_above <= b)) for a, b in zip(lo_a, hi_a)]
+    k = int(np.argmax(counts))
+    lo, hi = _segments(r_root, gap)
+    near = (hi >= lo_a[k] - gap) & (lo <= hi_a[k] + gap)
+    return float(hi[near].max()) if near.any() else float(r_root.max())
+
+
 def count_jets(rim: np.ndarray, prominence: float) -> int:
     """Peaks of a periodic profile that stand ``prominence`` above the lowest point between
     them and the next peak on either side (nan bins are gaps at the film level)."""
@@ -110,11 +140,15 @@ def count_jets(rim: np.ndarray, prominence: float) -> int:
 
 
 def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
-            sectors: Optional[int] = None, edge: Optional[float] = None) -> CrownMetrics:
+            sectors: Optional[int] = None, edge: Optional[float] = None,
+            planes: Sequence[int] = ()) -> CrownMetrics:
     """The metrics of one frame from the fluid particle positions ``pos`` (N x dim); with
-    ``edge``, liquid farther than that from the axis is never 'raised' (see the rules)."""
-    pos = np.asarray(pos, dtype=float)
-    dim = pos.shape[1]
+    ``edge``, liquid farther than that from the axis is never 'raised' (see the rules). With
+    symmetry ``planes`` (axes), ``pos`` is the simulated part and the metrics are the mirrored
+    whole's (its bodies grouped without building them: ``clusters.whole_groups``)."""
+    part = np.asarray(pos, dtype=float)
+    dim = part.shape[1]
+    pos = mirror_whole({"pos": part}, planes)["pos"]
     z = pos[:, -1]
     raised = z > film + RAISED_L0 * l0
     if edge is not None:
@@ -124,7 +158,7 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
     if not raised.any():
         return CrownMetrics(time, nan, 0.0, nan, 0, 0, 0, 0, False,
                             "no crown: nothing stands 2 l0 above the film", nan)
-    label = groups(pos, LINK_L0 * l0)
+    label, coherence_label = whole_groups(part, (LINK_L0 * l0, COHERENCE_LINK_L0 * l0), planes)
     ids, counts = np.unique(label, return_counts=True)
     main = label == ids[np.argmax(counts)]
     drops = raised & ~main
@@ -136,7 +170,7 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
         r = np.abs(pos[:, 0])
         theta = np.where(pos[:, 0] >= 0, 0.5 * math.pi, -0.5 * math.pi)
     body = raised & main
-    coherence = sheet_coherence(pos, raised, l0)
+    coherence = sheet_coherence(coherence_label, raised)
     if not body.any():          # only what is apart from the film is raised (the falling drop)
         return CrownMetrics(time, nan, 0.0, nan, 0, n_drops, int(drops.sum()),
                             int(raised.sum()), False, "no crown: nothing raised stands on the "
@@ -146,7 +180,11 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
         root = body
     n_sec = 2 if dim == 2 else (sectors or 16)
     sec = _sectors(theta, n_sec)
-    base = float(np.nanmedian(_per_sector(r[root], sec[root], n_sec, np.max)))
+    above = body & (z >= film + ROOT_TOP_L0 * l0) & (z < film + ABOVE_TOP_L0 * l0)
+    feet = np.full(n_sec, np.nan)
+    for s_ in np.unique(sec[root]):
+        feet[s_] = _foot(r[root & (sec == s_)], r[above & (sec == s_)], FOOT_GAP_L0 * l0)
+    base = float(np.nanmedian(feet))
     wall = body & (r > 0.5 * base)
     if not wall.any():
         wall = body
@@ -175,14 +213,13 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
                         int(drops.sum()), int(raised.sum()), bool(crown), why, coherence)
 
 
-def sheet_coherence(pos: np.ndarray, raised: np.ndarray, l0: float) -> float:
-    """The fraction of the ``raised`` particles of ``pos`` (the fluid) that belong to the
-    largest group of fluid particles linked closer than COHERENCE_LINK_L0 l0; nan when none
-    is raised."""
+def sheet_coherence(label: np.ndarray, raised: np.ndarray) -> float:
+    """The fraction of the ``raised`` fluid particles that belong to the largest group of the
+    fluid (``label``: its groups linked closer than COHERENCE_LINK_L0 l0); nan when none is
+    raised."""
     n_raised = int(np.count_nonzero(raised))
     if n_raised == 0:
         return math.nan
-    label = groups(pos, COHERENCE_LINK_L0 * l0)
     ids, counts = np.unique(label, return_counts=True)
     body = label == ids[np.argmax(counts)]
     return float(np.count_nonzero(raised & body)) / n_raised

@@ -93,7 +93,8 @@ def run_point(dim: int, l0: float, factor: float, preset: str = PRESET,
         pos = snap["pos"][fluid]
         d = density_excess(pos, snap["number_density"][fluid], sim_.lattice.n0,
                            sim_.lattice.re, beta)
-        m = measure(pos, sim_.stats.time, s["film"], s["drop"], l0, edge=edge)
+        m = measure(pos, sim_.stats.time, s["film"], s["drop"], l0, edge=edge,
+                    planes=sim_.model.mirror_planes)
         looks.append({"time": sim_.stats.time, "density": d.as_dict(), "crown": m.as_dict()})
 
     def on_step(sim_) -> None:

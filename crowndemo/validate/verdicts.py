@@ -99,9 +99,9 @@ def run_and_observe(sim: Simulator, resolved: config.Resolved, scene_info: Optio
     edge = film_limit(scene_info, resolved.l0)
 
     def observe(sim_, i):
-        snap = sim_.whole_snapshot()        # a half or quarter run mirrored (symmetry.py)
+        snap = sim_.snapshot()              # a half or quarter run: measured as the whole
         seen.append(measure(snap["pos"][snap["kind"] == FLUID], sim_.stats.time, s["film"],
-                            s["drop"], resolved.l0, edge=edge))
+                            s["drop"], resolved.l0, edge=edge, planes=sim_.model.mirror_planes))
     outcome = "ran to the end"
     try:
         sim.run(resolved.t_end, on_frame=observe,
