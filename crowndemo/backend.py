@@ -22,6 +22,7 @@ class Backend:
     seed: int
     single_thread: bool
     fast_compile: bool = False    # Taichi's advanced IR optimisations off on the CPU arch
+    threads: Optional[int] = None  # CPU threads (None: Taichi's default, every core)
 
 
 _current: Optional[Backend] = None
@@ -64,7 +65,7 @@ def _arch_object(name: str):
 
 def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
          single_thread: bool = False, quiet: bool = True,
-         fast_compile: Optional[bool] = None) -> Backend:
+         fast_compile: Optional[bool] = None, threads: Optional[int] = None) -> Backend:
     """Start Taichi once per process.
 
     ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` is CUDA where
@@ -72,7 +73,9 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
     ``fast_compile`` (None: ``$CROWNDEMO_FAST_COMPILE`` = 1, true, yes or on) turns Taichi's advanced IR
     optimisations off on the CPU arch: the 3D crown step compiles in 13-19 s instead of
     46-55 s and runs 5-10 % slower (BENCHMARKS.md, "Compiling"); no effect on other archs.
-    A second call with the same settings is a no-op; with other settings Taichi is reset.
+    ``threads``: the CPU arch's thread count (a sweep's Dask worker: its share of the cores;
+    ``single_thread`` is 1). A second call with the same settings is a no-op; with other
+    settings Taichi is reset.
     """
     global _current
     if fast_compile is None:
@@ -83,9 +86,14 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
                            "(--arch or CROWNDEMO_ARCH)")
     if precision not in PRECISIONS:
         raise BackendError(f"precision {precision!r} is not one of {', '.join(PRECISIONS)}")
-    wanted = (arch, precision, int(seed), bool(single_thread), bool(fast_compile))
+    if threads is not None and not (isinstance(threads, int) and threads >= 1):
+        raise BackendError(f"threads = {threads!r}: allowed: an integer >= 1")
+    if single_thread:
+        threads = 1
+    wanted = (arch, precision, int(seed), bool(single_thread), bool(fast_compile), threads)
     if _current is not None and (_current.arch, _current.precision, _current.seed,
-                                 _current.single_thread, _current.fast_compile) == wanted:
+                                 _current.single_thread, _current.fast_compile,
+                                 _current.threads) == wanted:
         return _current
     if _current is not None:
         ti.reset()
@@ -102,8 +110,8 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
                   default_ip=ti.i32, random_seed=int(seed), offline_cache=True,
                   advanced_optimization=not (fast_compile and target == "cpu"),
                   log_level=ti.WARN if quiet else ti.INFO)
-    if single_thread:
-        kwargs["cpu_max_num_threads"] = 1
+    if threads is not None:
+        kwargs["cpu_max_num_threads"] = threads
     # ti.init prints "[Taichi] Starting on arch=..." on stdout, at every start (a restart for
     # another precision too): it goes to stderr, so that stdout holds only what the command
     # prints (one JSON document with --json)
@@ -114,7 +122,7 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
                            "(it fell back to the CPU); use --arch cpu")
     resolved = str(ti.lang.impl.current_cfg().arch).split(".")[-1]
     _current = Backend(arch, resolved, precision, int(seed), bool(single_thread),
-                       bool(fast_compile))
+                       bool(fast_compile), threads)
     return _current
 
 

@@ -20,7 +20,7 @@ from ..interrupt import StopRun, stop_if_asked
 
 PROG = "crowndemo"
 # exit statuses besides 0, the same for every command (MAIN_EPILOG in cli/__init__ lists them)
-EXIT_FAILED = 1             # a recording's video could not be made, or a validation check failed
+EXIT_FAILED = 1             # a video could not be made, a validation check or a sweep point failed
 EXIT_USAGE = 2              # a usage or parameter error (error() below): "error: ..."
 EXIT_UNSTABLE = 3           # the run broke a health limit (InstabilityError): "unstable: ..."
 EXIT_INTERRUPTED = 130      # stopped by Ctrl-C (128 + SIGINT, as a shell reports it)
