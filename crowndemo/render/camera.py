@@ -23,6 +23,10 @@ Vec3 = Tuple[float, float, float]
 MARGIN = 0.85            # the framed box fills at most this fraction of the half-image
 
 
+FRAME_REACH = 1.3       # the frame's half width / Yarin & Weiss's crown base radius at t_end
+FRAME_TOP = 0.5         # its height above the film / that radius
+
+
 @dataclass(frozen=True)
 class Geometry:
     """What the camera and the floor need to know about a drop-on-film scene (metres)."""
@@ -42,12 +46,15 @@ class Geometry:
                    s["t_end"], resolved.l0)
 
     def frame_box(self) -> Tuple[np.ndarray, np.ndarray]:
-        """The box to keep in view: the drop at t = 0 and the crown by t_end (its base radius
-        from Yarin & Weiss, its height taken as that radius), within the floor."""
+        """The box to keep in view: the drop at t = 0 and the crown by t_end, within the floor:
+        out to 1.3 Yarin & Weiss base radii (the runs' crowns stand at 0.75-0.8 of it,
+        VALIDATION.md crown-base: their spray has room) and up to half that radius (the rims
+        measured at 4 ms stand at 0.25-0.3 of it, the jets' tips higher; the box used to be
+        as high as the radius, which left the crown small in a tall empty frame)."""
         rc = crown_base_radius(self.t_end - self.gap / self.speed, self.speed, self.drop,
                                self.film)
-        half = min(max(1.3 * rc, 0.75 * self.drop), self.floor / 2)
-        top = max(self.film + self.gap + self.drop, self.film + rc)
+        half = min(max(FRAME_REACH * rc, 0.75 * self.drop), self.floor / 2)
+        top = max(self.film + self.gap + self.drop, self.film + FRAME_TOP * rc)
         depth = half if self.dim == 3 else self.slice_depth / 2
         return np.array([-half, -depth, 0.0]), np.array([half, depth, top])
 
