@@ -270,3 +270,24 @@ def test_landed_spray_beyond_the_wall_is_not_the_base():
     m = measure(pts, 1e-3, H, D, L0)
     assert m.base_radius == pytest.approx(R + T / 2 - L0 / 2, abs=L0)
     assert m.crown, m.verdict
+
+
+def test_a_swollen_film_is_the_film_not_raised_liquid():
+    """The far film swollen by 3 l0 (every layer stretched, as the seed rung's film under the
+    potential surface tension at D/l0 = 100): measured from the film's surface as it stands,
+    the wall's base and height are those of the unswollen case, and the swell is reported;
+    measured from the built surface the whole film would read as raised."""
+    from crowndemo.validate.crown_metrics import film_edge
+    R, T, top, extent = 3.0e-3, 4 * L0, H + 2.0e-3, 8.0e-3
+    flat = film(extent)
+    swollen = flat * np.array([1.0, 1.0, (H + 3 * L0) / H])          # 10 layers over 1.3 mm
+    wall = shell(R, T, lambda t: top + 3 * L0)
+    edge = film_edge(extent, L0)
+    ref = measure(np.concatenate([flat, shell(R, T, lambda t: top)]), 1e-3, H, D, L0, edge=edge)
+    m = measure(np.concatenate([swollen, wall]), 1e-3, H, D, L0, edge=edge)
+    # the top layer's centres (9.5 l0, stretched to 12.35 l0) + l0/2 above the built 10 l0
+    assert m.film_swell == pytest.approx(swollen[:, 2].max() + 0.5 * L0 - H, rel=1e-6)
+    assert ref.film_swell == 0.0
+    assert m.base_radius == pytest.approx(ref.base_radius, abs=L0)
+    assert m.rim_height == pytest.approx(ref.rim_height, abs=L0) and m.crown
+    assert m.raised_particles < 1.1 * ref.raised_particles

@@ -6,6 +6,8 @@ y = 0), the floor surface z = 0, the undisturbed film surface z = h. In 2D the '
 |x| and the two sides of the slice are the two 'sectors'.
 
 The rules, each a few lines below:
+- the film surface: the built thickness h, or the far film's surface where the far film
+  has swollen above it (``film_surface``; reported as ``film_swell``);
 - raised liquid: particles more than 2 l0 above the undisturbed film surface, and nearer the
   axis than ``edge`` when one is given (inside a trimmed film's free edge, which slumps and
   rises on its own, or inside the container's side walls: by 4 ms the liquid in a corner of
@@ -75,9 +77,25 @@ class CrownMetrics:
     crown: bool
     verdict: str                # one line: why crown or no crown
     sheet_coherence: float = math.nan   # raised liquid in the one body / all raised (0..1)
+    film_swell: float = 0.0     # m: the far film's surface above the built film's (film_surface)
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+def film_surface(z: np.ndarray, axial: np.ndarray, film: float, l0: float,
+                 edge: Optional[float]) -> float:
+    """The undisturbed film's surface as it stands: the built thickness ``film``, or higher
+    where the film far from the impact has swollen (the top layer's centres, 99th percentile,
+    + l0/2, in the ring from 0.75 ``edge`` to ``edge``; without an edge, ``film``). The seed's
+    potential surface tension swells a film at D/l0 = 100 (VALIDATION.md, "The seed rung"):
+    measured from the built surface, the whole film would read as raised liquid."""
+    if edge is None:
+        return film
+    ring = (axial >= 0.75 * edge) & (axial < edge)
+    if np.count_nonzero(ring) < 16:
+        return film
+    return max(film, float(np.percentile(z[ring], 99)) + 0.5 * l0)
 
 
 def _sectors(theta: np.ndarray, n: int) -> np.ndarray:
@@ -150,14 +168,17 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
     dim = part.shape[1]
     pos = mirror_whole({"pos": part}, planes)["pos"]
     z = pos[:, -1]
+    axial = np.hypot(pos[:, 0], pos[:, 1]) if dim == 3 else np.abs(pos[:, 0])
+    built = film
+    film = film_surface(z, axial, film, l0, edge)
     raised = z > film + RAISED_L0 * l0
     if edge is not None:
-        axial = np.hypot(pos[:, 0], pos[:, 1]) if dim == 3 else np.abs(pos[:, 0])
         raised &= axial < edge
     nan = math.nan
     if not raised.any():
         return CrownMetrics(time, nan, 0.0, nan, 0, 0, 0, 0, False,
-                            "no crown: nothing stands 2 l0 above the film", nan)
+                            "no crown: nothing stands 2 l0 above the film", nan,
+                            film - built)
     label, coherence_label = whole_groups(part, (LINK_L0 * l0, COHERENCE_LINK_L0 * l0), planes)
     ids, counts = np.unique(label, return_counts=True)
     main = label == ids[np.argmax(counts)]
@@ -174,7 +195,8 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
     if not body.any():          # only what is apart from the film is raised (the falling drop)
         return CrownMetrics(time, nan, 0.0, nan, 0, n_drops, int(drops.sum()),
                             int(raised.sum()), False, "no crown: nothing raised stands on the "
-                            "film (the liquid above it is apart from it)", coherence)
+                            "film (the liquid above it is apart from it)", coherence,
+                            film - built)
     root = body & (z < film + ROOT_TOP_L0 * l0)
     if not root.any():
         root = body
@@ -210,7 +232,8 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
                f"{CROWN_MIN_HEIGHT_D * drop * 1e3:.3g} mm) at r = {base * 1e3:.3g} mm (needs > "
                f"D/2), {rim_thickness * 1e3:.2g} mm thick (needs < its height)")
     return CrownMetrics(time, base, rim_height, rim_thickness, jets, n_drops,
-                        int(drops.sum()), int(raised.sum()), bool(crown), why, coherence)
+                        int(drops.sum()), int(raised.sum()), bool(crown), why, coherence,
+                        film - built)
 
 
 def sheet_coherence(label: np.ndarray, raised: np.ndarray) -> float:
