@@ -178,3 +178,20 @@ def test_journal_reads_back_its_points_and_drops_a_torn_last_line(tmp_path):
     assert len(open(j.path).read().splitlines()) == 2     # rewritten without the torn line
     with pytest.raises(JournalError, match="written by another sweep"):
         Journal(str(tmp_path), dict(ident, sets=[]), resume=True)
+
+
+def test_scheduler_address_runs_the_points_on_that_clusters_workers(tmp_path):
+    """--scheduler ADDRESS: a scheduler started apart (here a LocalCluster of one worker,
+    as dask-jobqueue or dask-kubernetes would start one) runs the points; the sweep closes
+    only its client, the cluster stays up."""
+    import distributed
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        done = _sweep(tmp_path / "map", "--scheduler", cluster.scheduler_address,
+                      "--threads", "1", speeds=["2", "4"])
+        assert f"on the Dask scheduler at {cluster.scheduler_address}: 1 worker" in done.stderr
+        assert [p["speed"] for p in _points(tmp_path / "map")] == [2.0, 4.0]
+        with distributed.Client(cluster) as client:              # still there
+            assert len(client.scheduler_info()["workers"]) == 1
+    done = _sweep(tmp_path / "gone", "--scheduler", "tcp://127.0.0.1:9", check=False)
+    assert done.returncode == 2 and "no Dask scheduler answered" in done.stderr

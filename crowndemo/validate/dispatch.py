@@ -103,7 +103,7 @@ class Cluster:
                     signal.signal(signal.SIGINT, previous)
                 self.client = dist.Client(self.cluster)
             else:
-                self.client = dist.Client(self.scheduler, timeout="20s")
+                self.client = dist.Client(self.scheduler, timeout="10s")
             self.client.register_plugin(LeaveCtrlCToTheSweep())
         except OSError as e:
             self.close()
