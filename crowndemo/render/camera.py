@@ -24,7 +24,7 @@ MARGIN = 0.85            # the framed box fills at most this fraction of the hal
 
 
 FRAME_REACH = 1.3       # the frame's half width / Yarin & Weiss's crown base radius at t_end
-FRAME_TOP = 0.5         # its height above the film / that radius
+FRAME_TOP = 1.0         # its height above the film / that radius
 
 
 @dataclass(frozen=True)
@@ -48,9 +48,9 @@ class Geometry:
     def frame_box(self) -> Tuple[np.ndarray, np.ndarray]:
         """The box to keep in view: the drop at t = 0 and the crown by t_end, within the floor:
         out to 1.3 Yarin & Weiss base radii (the runs' crowns stand at 0.75-0.8 of it,
-        VALIDATION.md crown-base: their spray has room) and up to half that radius (the rims
-        measured at 4 ms stand at 0.25-0.3 of it, the jets' tips higher; the box used to be
-        as high as the radius, which left the crown small in a tall empty frame)."""
+        VALIDATION.md crown-base: their spray has room) and up to that radius. A box half as
+        high (the rims stand at 0.25-0.3 of it) brings the camera closer, but recordings
+        with it drew frames without the liquid (issue 22's note): not adopted."""
         rc = crown_base_radius(self.t_end - self.gap / self.speed, self.speed, self.drop,
                                self.film)
         half = min(max(FRAME_REACH * rc, 0.75 * self.drop), self.floor / 2)
