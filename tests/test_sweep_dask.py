@@ -152,6 +152,8 @@ def test_resume_of_another_sweep_and_bad_worker_counts_are_refused(tmp_path):
     done = _sweep(out, "--workers", str(cores + 1), check=False)
     assert done.returncode == 2
     assert f"--workers {cores + 1}: allowed 1 to {cores}" in done.stderr
+    done = _sweep(out, "--workers", str(cores + 1), "--threads", "1", check=False)
+    assert done.returncode == 2 and f"--workers {cores + 1}: allowed" in done.stderr
     done = _sweep(out, "--threads", "1", check=False)
     assert done.returncode == 2 and "--threads sets each Dask worker's threads" in done.stderr
     assert dispatch.threads_per_worker(2, cores=16) == 8

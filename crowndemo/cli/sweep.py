@@ -6,8 +6,8 @@ import re
 import shlex
 import sys
 
-from .common import (EXIT_INTERRUPTED, EXIT_FAILED, PRESET_HELP, PROG, Fmt, UsageError, add_quality,
-                     add_sets, load_preset, path_argument, repo_root, require_folder,
+from .common import (EXIT_FAILED, EXIT_INTERRUPTED, PRESET_HELP, PROG, Fmt, UsageError,
+                     add_quality, add_sets, load_preset, path_argument, repo_root, require_folder,
                      start_backend)
 
 # numbers like -1e-3 are values, not options (argparse alone knows only -1 and -0.5)
@@ -123,8 +123,7 @@ def _sweep(args, argv) -> int:
     todo = [r for r in resolved if sweep.key_of(r) not in journal.done]
     if args.resume:
         print(f"{PROG}: --resume: {len(resolved) - len(todo)} of {len(resolved)} points done "
-              f"before"
-              f" ({journal.path}), {len(todo)} to run", file=sys.stderr, flush=True)
+              f"before ({journal.path}), {len(todo)} to run", file=sys.stderr, flush=True)
     print(f"{PROG}: sweep {base.name} ({base.quality}): {len(films)} films x {len(speeds)} "
           "speeds", file=sys.stderr, flush=True)
 

@@ -184,11 +184,10 @@ def measure(pos: np.ndarray, time: float, film: float, drop: float, l0: float,
     main = label == ids[np.argmax(counts)]
     drops = raised & ~main
     n_drops = len(np.unique(label[drops]))
+    r = axial
     if dim == 3:
-        r = np.hypot(pos[:, 0], pos[:, 1])
         theta = np.arctan2(pos[:, 1], pos[:, 0])
     else:
-        r = np.abs(pos[:, 0])
         theta = np.where(pos[:, 0] >= 0, 0.5 * math.pi, -0.5 * math.pi)
     body = raised & main
     coherence = sheet_coherence(coherence_label, raised)

@@ -76,8 +76,8 @@ class Cluster:
         if (workers is None) == (scheduler is None):
             raise DispatchError("give either --workers N or --scheduler ADDRESS")
         self.workers, self.scheduler = workers, scheduler
-        self.threads = threads if threads is not None or workers is None \
-            else threads_per_worker(workers)
+        share = None if workers is None else threads_per_worker(workers)   # checks the count
+        self.threads = threads if threads is not None else share
         self.client = self.cluster = None
         self._futures: dict = {}
 
@@ -157,12 +157,13 @@ class Cluster:
         done = dist.as_completed()
 
         def submit_more() -> None:
-            while waiting and len(futures) < self.slots:
+            slots = self.slots
+            while waiting and len(futures) < slots:
                 r = waiting.pop(0)
-                key = f"point-{uuid.uuid4().hex[:8]}"
-                futures[self.client.submit(run_point, r, spec, pure=False, key=key)] = \
-                    sweep.key_of(r)
-                done.add(list(futures)[-1])
+                f = self.client.submit(run_point, r, spec, pure=False,
+                                       key=f"point-{uuid.uuid4().hex[:8]}")
+                futures[f] = sweep.key_of(r)
+                done.add(f)
             progress.running = len(futures)
         try:
             submit_more()

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Dict, List
+from typing import Dict
 
 from ..strictjson import finite_or_none
 from .sweep import Point
@@ -63,9 +63,6 @@ class Journal:
             f.write(json.dumps(finite_or_none(point.as_dict())) + "\n")
             f.flush()
             os.fsync(f.fileno())
-
-    def points(self) -> List[Point]:
-        return list(self.done.values())
 
 
 __all__ = ["Journal", "JournalError", "NAME"]
