@@ -11,8 +11,8 @@ import taichi as ti
 from crowndemo import config
 from crowndemo.config import PresetError
 from crowndemo.core import ParameterError, Simulator
-from crowndemo.core.step import (FIELD_ENTRIES_MAX, Model, entries_per_particle,
-                                 max_particles)
+from crowndemo.core.step import (CELLS_PER_PARTICLE_MIN, FIELD_ENTRIES_MAX, Model,
+                                 default_max_cells, entries_per_particle, max_particles)
 
 
 def _fields(root):
@@ -39,11 +39,19 @@ def test_no_field_holds_more_entries_per_particle_than_the_limit_allows(preset):
     scene = config.load(preset, "draft").build_scene()
     sim = Simulator(scene.physics, scene.numerics, len(scene.pos))
     cap, m = sim.state.capacity, entries_per_particle(sim.model)
-    entries = [int(np.prod(f.shape)) for f in _fields(sim)]
+    cells = {id(sim.grid.cell_count), id(sim.grid.cell_start)}
+    fields = _fields(sim)
+    entries = [int(np.prod(f.shape)) for f in fields if id(f) not in cells]
     assert len(entries) > 30                            # the walk found the simulator's fields
     assert max(entries) <= m * cap + 1                  # so at max_particles: < 2^31 entries
     assert max(entries) >= m * cap                      # and the bound is the tight one
     assert (max_particles(sim.model) * m + 1) <= FIELD_ENTRIES_MAX
+    # the cells: as many as default_max_cells gives, which is capped at the limit itself and
+    # holds CELLS_PER_PARTICLE_MIN (<= m) a particle even at max_particles
+    assert sim.grid.max_cells == default_max_cells(cap)
+    assert default_max_cells(max_particles(sim.model)) + 1 <= FIELD_ENTRIES_MAX
+    assert default_max_cells(max_particles(sim.model)) >= (
+        CELLS_PER_PARTICLE_MIN * max_particles(sim.model))
 
 
 def test_simulator_refuses_a_capacity_past_the_limit_before_allocating():

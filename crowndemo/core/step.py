@@ -84,7 +84,8 @@ def capacity_bucket(particles: int) -> int:
     return c
 
 
-CELLS_PER_PARTICLE = 16
+CELLS_PER_PARTICLE = 96        # allocated (at most FIELD_ENTRIES_MAX entries in all)
+CELLS_PER_PARTICLE_MIN = 16    # held at every capacity up to max_particles
 
 
 def default_max_cells(particles: int) -> int:
@@ -92,8 +93,12 @@ def default_max_cells(particles: int) -> int:
     A film on a wide floor fills a flat box thinly: the booth 3m-drop (643k particles) needs
     3.1 M cells of side re/2 before the splash rises. Under a limit of 2 per particle its cells
     grew to 0.69 re, the walks visited 2.6 times the candidates and the step took 1.6 times
-    as long (BENCHMARKS.md). A cell costs 8 bytes; only the cells in use are scanned."""
-    return max(CELLS_PER_PARTICLE * particles, 4096)
+    as long. After the splash the box grows tall and stays sparse: the seed rung's spray
+    reaches 62 mm above a 1 mm film by 4 ms, 114 M cells of side re/2 for 1.23 M particles.
+    Under 16 per particle the side grew to 1.9 l0 and the step took 1.7 times as long as with
+    96 (BENCHMARKS.md). A cell costs 8 bytes; only the cells in use are scanned (2 x 3 passes
+    a step), so a compact scene pays nothing for the room."""
+    return max(min(CELLS_PER_PARTICLE * particles, FIELD_ENTRIES_MAX - 1), 4096)
 
 
 # Taichi 1.7.4 indexes a field's entries with 32-bit integers: a field of 2^31 entries or more
@@ -110,9 +115,10 @@ def capacity_for(scene) -> int:
 
 def entries_per_particle(model: Model) -> int:
     """The most entries per particle of capacity held by one field of a simulator for
-    ``model``: the cell grid's cells (CELLS_PER_PARTICLE), the neighbour list's slots, the
+    ``model``, the cell grid's fields apart (capped at FIELD_ENTRIES_MAX, default_max_cells):
+    the cells it holds at least (CELLS_PER_PARTICLE_MIN), the neighbour list's slots, the
     close-pair list's slots."""
-    m = CELLS_PER_PARTICLE
+    m = CELLS_PER_PARTICLE_MIN
     if model.neighbour_list:
         m = max(m, SLOTS[model.dim])
     if model.collision:
