@@ -171,6 +171,11 @@ NUMERICS_KEYS = {
                            lo=0, lo_incl=True, hi=1_000_000),
     "neighbour_list": Field("bool", "list each fluid particle's neighbours in the density pass "
                             "for the pressure gradient (same results, faster)", default=True),
+    "predictor_list": Field("bool", "the predictor's neighbours (viscosity, surface tension, "
+                            "collisions) from the density pass's list of the step before, "
+                            "moved only by the corrector, instead of a cell walk of their own "
+                            "(needs neighbour_list; faster, results within float noise of the "
+                            "walk's)", default=True),
     "cells_per_re": Field("int", "cells of side re/k: the neighbour walk visits the cells of "
                           "the (2k + 1)^d block around that can hold a neighbour",
                           lo=1, lo_incl=True, hi=3, hi_incl=True),

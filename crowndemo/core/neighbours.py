@@ -41,6 +41,9 @@ class NeighbourList:
         if self.layout not in LAYOUTS:
             raise ParameterError("layout", self.layout, ", ".join(LAYOUTS), source="NeighbourList")
         self.count = ti.field(ti.i32, state.capacity)
+        # set when some particle of the last listing had more neighbours than slots (its
+        # list is incomplete: a pass that cannot walk the cells must not use the lists)
+        self.overflow = ti.field(ti.i32, shape=())
         self.index = ti.field(ti.i32)           # [particle, slot] in either layout
         if self.layout == "slot":
             ti.root.dense(ti.j, self.slots).dense(ti.i, state.capacity).place(self.index)
@@ -49,7 +52,7 @@ class NeighbourList:
 
     def nbytes(self) -> int:
         from .state import field_nbytes
-        return field_nbytes(self.count) + field_nbytes(self.index)
+        return field_nbytes(self.count) + field_nbytes(self.index) + field_nbytes(self.overflow)
 
     @ti.func
     def add(self, i, j, n):
@@ -57,6 +60,10 @@ class NeighbourList:
         if n < ti.static(self.slots):
             self.index[i, n] = j
         return n + 1
+
+    def complete(self) -> bool:
+        """Every list of the last listing holds all its neighbours (a read-back)."""
+        return int(self.overflow[None]) == 0
 
     @ti.func
     def fits(self, i) -> bool:

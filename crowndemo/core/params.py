@@ -98,6 +98,10 @@ class Numerics:
     neighbour_list: bool = True     # the density pass lists each fluid particle's neighbours
     #                                 for the pressure gradient (core/neighbours.py)
     cells_per_re: int = 2           # cells of side re/k, a walk within (2k + 1)^d cells (grid.py)
+    # the predictor's pairs (S12, S22, the collision model) at r^k taken from the density
+    # pass's list of the step before (at r*, then moved by the corrector's dt^2 a', S20)
+    # instead of a grid build and cell walk of their own (terms.py: what it misses)
+    predictor_list: bool = True
     # the floor (z = 0): layers of wall and dummy particles, or the analytic plane floor
     # (core/plane_floor.py: their contributions tabulated against the height; no particles)
     wall_model: str = "particles"
@@ -124,6 +128,7 @@ class Numerics:
              "0 <= x < 1 (a fraction of l0; 0: off)")
         need(_finite(self.restitution) and 0 <= self.restitution <= 1, "restitution", "0 .. 1")
         need(isinstance(self.neighbour_list, bool), "neighbour_list", "true or false")
+        need(isinstance(self.predictor_list, bool), "predictor_list", "true or false")
         need(self.wall_model in WALL_MODELS, "wall_model", " | ".join(WALL_MODELS))
         need(self.courant_speed in COURANT_SPEEDS, "courant_speed", " | ".join(COURANT_SPEEDS))
         need(isinstance(self.cells_per_re, int) and not isinstance(self.cells_per_re, bool)
@@ -153,13 +158,15 @@ class Model:
     plane_floor: bool = False
     relative_courant: bool = False   # the relative speed measured (terms.py)
     mirror_planes: Tuple[int, ...] = ()   # symmetry planes (symmetry.py)
+    predictor_list: bool = False     # the predictor's pairs from the last list (terms.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
                    numerics.cells_per_re, numerics.wall_model == "plane",
-                   numerics.courant_speed == "relative", tuple(numerics.mirror_planes))
+                   numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
+                   numerics.predictor_list and numerics.neighbour_list)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
@@ -167,7 +174,8 @@ class Model:
                 "collision": self.collision, "neighbour_list": self.neighbour_list,
                 "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor,
                 "relative_courant": self.relative_courant,
-                "mirror_planes": list(self.mirror_planes)}
+                "mirror_planes": list(self.mirror_planes),
+                "predictor_list": self.predictor_list}
 
 
 def _finite(x) -> bool:

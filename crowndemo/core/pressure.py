@@ -73,6 +73,8 @@ class Pressure:
         neighbour list, each fluid particle's non-dummy neighbours are listed on the way."""
         n0, c2, rho, beta = self.coef.n0[None], self.coef.c2[None], self.coef.rho[None], \
             self.coef.beta[None]
+        if ti.static(self.model.neighbour_list):
+            self.neighbours.overflow[None] = 0
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             k = self.state.kind[i]
@@ -84,6 +86,8 @@ class Pressure:
                         self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                      self._density_listing_pair, acc)
                         self.neighbours.count[i] = acc.count
+                        if acc.count > ti.static(self.neighbours.slots):
+                            self.neighbours.overflow[None] = 1     # the same value from all
                         n = acc.n
                     else:
                         self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],

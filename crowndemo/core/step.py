@@ -162,8 +162,12 @@ class Simulator:
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.floor = PlaneFloor() if self.model.plane_floor else None   # else not allocated
-        self.predictor = Predictor(self.model, self.grid, self.coef, self.floor)
         self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
+        self.predictor = Predictor(self.model, self.grid, self.coef, self.floor,
+                                   self.pressure.neighbours)
+        # the density pass's lists hold the pairs at the positions the corrector moved from
+        # (terms.py, the predictor's pairs from the list): False until a step has listed them
+        self._lists_ready = False
         self.health = Health(self.state, self.coef)
         # mirror images across the symmetry planes (symmetry.py); None for a whole scene
         self.symmetry = (Symmetry(self.state, self.model.mirror_planes)
@@ -199,9 +203,11 @@ class Simulator:
             self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio))
         if self.symmetry is not None:
             self.symmetry.configure(self.lattice.re)
+        self._lists_ready = False
 
     def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:
         self.state.load(pos, vel, kind)
+        self._lists_ready = False
         if self._auto_cells:    # as for a simulator sized to these particles (same results)
             self.grid.set_cell_limit(default_max_cells(len(pos)))
         self.n_fluid = int((np.asarray(kind) == FLUID).sum())
@@ -221,6 +227,7 @@ class Simulator:
     def restore_state(self, saved: dict) -> None:
         """Continue from ``save_state``'s result; call ``configure`` with the same values first."""
         self.state.restore(saved["particles"])
+        self._lists_ready = False       # the first step walks, as after the frame it saved at
         self.health.set_counters(saved["health_counters"])
         self.stats = copy.deepcopy(saved["stats"])
         self._last = self.stats.health
@@ -271,10 +278,17 @@ class Simulator:
         reorder = self.numerics.reorder_every > 0 and k % self.numerics.reorder_every == 0
         sym = self.symmetry
         self._stage(None)
+        from_list = self._lists_ready and self.predictor.takes_list
+        built = False
         if self.predictor.needs_neighbours:
-            self._build(reorder)                        # neighbours at r^k
+            if from_list:                               # the last lists' pairs (terms.py)
+                if sym is not None:
+                    sym.sync_motion()                   # the images follow the corrector
+            else:
+                self._build(reorder)                    # neighbours at r^k
+                built = True
             self._stage("grid")
-        self.predictor.forces()                         # S14 at r^k
+        self.predictor.forces(from_list)                # S14 at r^k
         relative = None                                 # the relative Courant limit's speed
         if self.predictor.measures_relative_speed:
             relative = self.predictor.relative_speed()  # at r^k, u^k: the walk just read it
@@ -283,12 +297,15 @@ class Simulator:
         if dt_cap < dt:
             dt, binding = dt_cap, "frame"
         self.predictor.run(dt, mark=self._stage,        # S15-S16
-                           sync=sym.sync_velocity if sym is not None else None)
+                           sync=sym.sync_velocity if sym is not None else None,
+                           from_list=from_list)
         if sym is not None:
             sym.reflect()                               # nothing crosses a plane
-        self._build(reorder and not self.predictor.needs_neighbours)  # at r*
+        self._build(reorder and not built)              # at r*
         self._stage("grid")
         self.pressure.density_and_pressure()            # S17 (M3)
+        if self.predictor.takes_list:                   # the next predictor's pairs
+            self._lists_ready = self.pressure.neighbours.complete()
         if sym is not None:
             sym.sync_pressure()                         # images' P_j for the corrector
         self._stage("density")
@@ -357,6 +374,9 @@ class Simulator:
         """P^{k+1} from n^{k+1} at the current positions (S21), for output only."""
         self._build(reorder=False)
         self.pressure.density_and_pressure()
+        # the next step walks: its result must not depend on whether the output looked (a
+        # resumed run starts with a walk after the frame its checkpoint was saved at)
+        self._lists_ready = False
 
     def snapshot(self) -> Dict[str, np.ndarray]:
         """The simulated particles (of a half or quarter with symmetry planes)."""

@@ -194,6 +194,24 @@ class Symmetry:
         self.state.n_images[None] = ti.min(self.wanted[None], self.state.capacity - n)
 
     @ti.kernel
+    def sync_motion(self):
+        """Images take their sources' (reflected) position and velocity, and their kind (a
+        source that left the domain takes its images with it): after the corrector (S20),
+        for a predictor that reuses the last images (terms.py, the predictor's pairs from
+        the list)."""
+        n = self.state.n[None]
+        for s in range(n, n + self.state.n_images[None]):
+            i = self.source[s]
+            x, u = self.state.pos[i], self.state.vel[i]
+            for b in ti.static(range(len(self.planes))):
+                if self.mask[s] >> b & 1:
+                    x[self.planes[b]] = -x[self.planes[b]]
+                    u[self.planes[b]] = -u[self.planes[b]]
+            self.state.pos[s] = x
+            self.state.vel[s] = u
+            self.state.kind[s] = self.state.kind[i]
+
+    @ti.kernel
     def sync_velocity(self):
         """Images take their sources' (reflected) velocity: after u* (S15)."""
         n = self.state.n[None]

@@ -16,6 +16,18 @@ instead (timestep.py): |u| dt <= C_a l0, so two particles closing head-on from b
 step at least re - 2 C_a l0 = 1.1 l0 apart (C_a = 0.5, re = 2.1 l0), in range and in the
 relative limit before they can come closer than the lattice spacing.
 
+The predictor's pairs from the list (``numerics.predictor_list``, the default): a step's
+density pass lists each fluid particle's neighbours within re at r* (S17, core/neighbours.py),
+and the corrector then moves every particle by dt^2 a' (S20) to r^{k+1}. The next predictor
+sums over that list at the new positions, keeping the pairs still within re, instead of
+building the grid at r^{k+1} and walking the cells. It misses only the pairs that the
+corrector's move brought within re: they lie within dt^2 |a'_i - a'_j| of re, where w
+(S10) and the potential's force (S22) vanish, and closer than the collision distance
+(0.5 l0) none can be. Dummy particles are not listed (no predictor term uses them). After a
+load, a restore and an output refresh (``Simulator.refresh_pressure``), and after a listing
+in which some particle had more neighbours than slots, the step walks the cells as without
+the option. Measured: BENCHMARKS.md, "the predictor's pairs from the list".
+
 Why collisions (measured on the ``quick`` crown, 4 mm drop at 8 m/s, l0 = 0.4 mm): particles on
 the free surface have P = 0 (M3), so nothing repels two of them that approach; in the splash
 pairs closed to 0.1-0.4 l0 before their number density passed beta n0. Then P jumped to
@@ -33,11 +45,12 @@ import taichi as ti
 from .blocks import blocks_for, groups_for
 from .coefficients import Coefficients
 from .grid import CellGrid
+from .neighbours import NeighbourList
 from .health import fluid_max
 from .operators import laplacian_pair, weight
 from .params import Model
 from .plane_floor import FLOOR_V, PlaneFloor
-from .state import DUMMY, FLUID
+from .state import DUMMY, FLUID, GONE
 
 CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per particle (rare: the
 #                     lattice has none; a splash a few)
@@ -54,8 +67,11 @@ def surface_tension_pair(rij, r, l0, re):
 @ti.data_oriented
 class Predictor:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients,
-                 floor: Optional[PlaneFloor] = None):
+                 floor: Optional[PlaneFloor] = None,
+                 neighbours: Optional[NeighbourList] = None):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
+        # the density pass's list, for the pairs of ``forces(from_list=1)`` (module docstring)
+        self.neighbours = neighbours if model.predictor_list and self._walks else None
         self.floor = floor          # the analytic plane floor when the model has one
         self.dim = model.dim
         self.pair_sums = ti.types.struct(visc=ti.types.vector(self.dim, float),
@@ -147,27 +163,55 @@ class Predictor:
                                                    self.coef.re[None])
 
     def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None,
-            sync: Optional[Callable[[], None]] = None) -> None:
+            sync: Optional[Callable[[], None]] = None, from_list: bool = False) -> None:
         """u* = u + dt a* (S15), a* from ``forces`` (which must have run at these positions),
         the collision model on u* at r^k, r* = r + dt u* (S16). ``mark(stage)`` is called as
         the "predictor" and "collision" stages end (the simulator's stage timer); ``sync()``
-        right after u*, before the collision pass reads the neighbours' u* (symmetry.py)."""
+        right after u*, before the collision pass reads the neighbours' u* (symmetry.py).
+        ``from_list``: as given to ``forces`` (a crowded particle's collision pairs from the
+        list, not the cells)."""
         self.accelerate(dt)
         if sync is not None and self.model.collision:
             sync()
         mark("predictor")
         if self.model.collision:
-            self.collide()
+            self.collide(from_list)
             mark("collision")
         self.move(dt)
 
+    @property
+    def takes_list(self) -> bool:
+        """``forces`` and ``collide`` can take their pairs from the density pass's list."""
+        return self.neighbours is not None
+
+    @ti.func
+    def _listed(self, i, xi, r2_max, task: ti.template(), acc: ti.template()):
+        """``task`` for the listed neighbours j of i (the density pass's list, module
+        docstring) with 0 < r2 = |x_j - x_i|^2 < r2_max at the current positions; a j that
+        has left the domain since is skipped."""
+        for m in range(self.neighbours.count[i]):
+            j = self.neighbours.index[i, m]
+            rij = self.state.pos[j] - xi
+            r2 = rij.dot(rij)
+            if r2 < r2_max and r2 > 0.0 and self.state.kind[j] != GONE:
+                task(i, j, rij, r2, acc)
+
+    def forces(self, from_list: bool = False) -> None:
+        """``_forces``: the predictor's accelerations at r^k (the cell walk's pairs, or with
+        ``from_list`` the density pass's list's, module docstring)."""
+        self._forces(int(from_list))
+
+    def collide(self, from_list: bool = False) -> None:
+        """``_collide``: the collision model on u* at r^k."""
+        self._collide(int(from_list))
+
     @ti.kernel
-    def forces(self):
+    def _forces(self, from_list: ti.i32):
         """a* = nu <lap u> + g + (C/m) sum of minus the potential's gradient (S14, S22) at
-        r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone). With the
-        relative Courant limit, the largest |u_j - u_i| of the walk's pairs (module
-        docstring): per particle into scratch_float, then reduced per block and over the
-        blocks."""
+        r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone); the
+        pairs from the cell walk, or with ``from_list`` from the density pass's list (module
+        docstring). With the relative Courant limit, the largest |u_j - u_i| of the pairs:
+        per particle into scratch_float, then reduced per block and over the blocks."""
         if ti.static(self._walks):
             visc = self.coef.nu[None] * (2.0 * self.dim) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
@@ -176,8 +220,15 @@ class Predictor:
                 if self.state.kind[i] == FLUID:
                     acc = self.pair_sums(visc=ti.Vector.zero(float, self.dim),
                                          st=ti.Vector.zero(float, self.dim), close=0, rel2=0.0)
-                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                                 self._pair, acc)
+                    listed = False
+                    if ti.static(self.takes_list):
+                        if from_list:
+                            self._listed(i, self.state.pos[i], self.coef.re2[None],
+                                         self._pair, acc)
+                            listed = True
+                    if not listed:
+                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                     self._pair, acc)
                     if ti.static(self.lists_close_pairs):
                         self.close_count[i] = acc.close
                     if ti.static(self.model.plane_floor):
@@ -218,9 +269,10 @@ class Predictor:
                     self.state.vel[i] += dt * self.coef.gravity[None]
 
     @ti.kernel
-    def collide(self):
+    def _collide(self, from_list: ti.i32):
         """The collision model on u* at r^k; Jacobi: every pair sees the u* of both before
-        either changes."""
+        either changes. A particle with more close pairs than CLOSE_SLOTS walks the cells,
+        or with ``from_list`` its list (the grid is not at r^k then)."""
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
@@ -234,6 +286,10 @@ class Predictor:
                             j = self.close_index[i, m]
                             rij = self.state.pos[j] - xi
                             self._collision_pair(i, j, rij, rij.dot(rij), du)
+                if ti.static(self.takes_list):
+                    if walk and from_list:
+                        self._listed(i, xi, self.coef.col_r2[None], self._collision_pair, du)
+                        walk = False
                 if walk:
                     self.grid.for_each_near(i, xi, self.coef.col_r2[None],
                                             self._collision_pair, du)
