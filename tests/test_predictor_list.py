@@ -3,7 +3,8 @@ core/terms.py): after a step, the predictor's accelerations (S12, S14, S22) summ
 listed pairs at the corrector's new positions equal those of a cell walk at those positions
 minus exactly the pairs the corrector's move brought within re. Those pairs are written out
 in numpy (the viscosity and potential terms, method.md S12 and S22) and each lies within the
-move, dt^2 |a'_i - a'_j| (S20), of re. A particle with an incomplete list, and the first step
+move, dt^2 |a'_i - a'_j| (S20), of re. The collision model's pairs, dummy particles included,
+are the walk's. A particle with an incomplete list, and the first step
 after a load or an output refresh, walk the cells."""
 import numpy as np
 import pytest
@@ -42,6 +43,18 @@ def predictor_accelerations(sim, from_list: bool) -> np.ndarray:
     """a* of the simulated particles (not their mirror images)."""
     sim.predictor.forces(from_list)
     return sim.state.scratch_vec.to_numpy()[: sim.state.count].astype(float)
+
+
+def close_pairs(sim) -> set:
+    """What the last ``forces`` listed for the collision model: per fluid particle its count
+    of pairs closer than the collision distance and, where the list holds them all, which."""
+    m = sim.state.count
+    count = sim.predictor.close_count.to_numpy()[:m]
+    index = sim.predictor.close_index.to_numpy()[:m]
+    kind = sim.state.kind.to_numpy()[:m]
+    slots = index.shape[1]
+    return {(i, int(count[i]), frozenset(index[i, : count[i]].tolist())
+             if count[i] <= slots else None) for i in np.flatnonzero(kind == FLUID)}
 
 
 def missed_pair_terms(sim, pos, vel, kind, listed) -> tuple:
@@ -93,9 +106,12 @@ def test_listed_pairs_are_the_walk_less_the_pairs_moved_into_range(single_thread
             pos = sim.state.pos.to_numpy()[:n].astype(float)
             vel = sim.state.vel.to_numpy()[:n].astype(float)
         a_list = predictor_accelerations(sim, True)
+        close_list = close_pairs(sim)
         sim._build(reorder=False)                # the grid at these positions, for the walk
         assert sim.state.count + int(sim.state.n_images[None]) == n
         a_walk = predictor_accelerations(sim, False)
+        # the collision model's pairs (closer than 0.5 l0, dummies included): the same
+        assert close_list == close_pairs(sim), name
         terms, nearest = missed_pair_terms(sim, pos, vel, kind, listed)
         m = sim.state.count                      # the simulated particles, images after them
         terms, kind = terms[:m], kind[:m]

@@ -58,9 +58,13 @@ class Pressure:
     @ti.func
     def _density_listing_pair(self, i, j, rij, r2, acc: ti.template()):
         """The number density's term (S9), and j in i's list unless it is a dummy (the
-        pressure gradient skips dummies, method.md §5)."""
+        pressure gradient skips dummies, method.md §5). With the predictor's pairs from the
+        list (terms.py) dummies are listed too: the collision model keeps fluid particles off
+        them, and the corrector skips them."""
         acc.n += weight(ti.sqrt(r2), self.coef.re[None])
-        if self.state.kind[j] != DUMMY:
+        if ti.static(self.model.predictor_list):
+            acc.count = self.neighbours.add(i, j, acc.count)
+        elif self.state.kind[j] != DUMMY:
             acc.count = self.neighbours.add(i, j, acc.count)
 
     @ti.func
@@ -70,7 +74,8 @@ class Pressure:
     @ti.kernel
     def density_and_pressure(self):
         """n (S9) and P (S17) for fluid and wall particles; dummies only count in n. With the
-        neighbour list, each fluid particle's non-dummy neighbours are listed on the way."""
+        neighbour list, each fluid particle's neighbours are listed on the way (dummies only
+        for the predictor's pairs from the list)."""
         n0, c2, rho, beta = self.coef.n0[None], self.coef.c2[None], self.coef.rho[None], \
             self.coef.beta[None]
         if ti.static(self.model.neighbour_list):
@@ -139,7 +144,11 @@ class Pressure:
                         for m in range(self.neighbours.count[i]):
                             j = self.neighbours.index[i, m]
                             rij = self.state.pos[j] - xi
-                            self._gradient_term(j, rij, rij.dot(rij), acc)
+                            if ti.static(self.model.predictor_list):   # dummies listed
+                                if self.state.kind[j] != DUMMY:
+                                    self._gradient_term(j, rij, rij.dot(rij), acc)
+                            else:
+                                self._gradient_term(j, rij, rij.dot(rij), acc)
                 if walk:
                     self.grid.for_each_neighbour(i, xi, self.coef.re2[None],
                                                  self._gradient_pair, acc)

@@ -23,7 +23,9 @@ sums over that list at the new positions, keeping the pairs still within re, ins
 building the grid at r^{k+1} and walking the cells. It misses only the pairs that the
 corrector's move brought within re: they lie within dt^2 |a'_i - a'_j| of re, where w
 (S10) and the potential's force (S22) vanish, and closer than the collision distance
-(0.5 l0) none can be. Dummy particles are not listed (no predictor term uses them). After a
+(0.5 l0) none can be. Dummy particles are listed for it: only the collision model uses them,
+and without it fluid driven into a particle floor passes its wall layer (the booth 3m-drop
+went unstable at 2.7 ms, a number-density excess of 0.52). After a
 load, a restore and an output refresh (``Simulator.refresh_pressure``), and after a listing
 in which some particle had more neighbours than slots, the step walks the cells as without
 the option. Measured: BENCHMARKS.md, "the predictor's pairs from the list".
