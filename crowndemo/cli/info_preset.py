@@ -68,6 +68,9 @@ def _preset_facts(r, tp) -> Dict:
         "run_seconds_estimate": est["run_seconds"],
         "run_seconds_at_U": est["run_seconds_at_U"],
         "compile_seconds": est["compile_seconds"],
+        "crown_cost": {"before_contact": est["crown_cost_calm"],
+                       "after_contact": est["crown_cost_splash"],
+                       "wall_or_dummy": estimate.WALL_COST},
         "throughput": {"fluid_particle_steps_per_s": tp.rate,
                        "all_particle_steps_per_s": tp.rate_total,
                        "bytes_per_particle": tp.bytes_per_particle, "source": tp.source},
@@ -189,10 +192,13 @@ def info_preset(args) -> int:
     print(f"  steps       ~{f['steps']:,} to t_end: dt {f['dt_s']:.3g} s until contact, then "
           f"{f['dt_after_contact_s']:.3g} s ({f['binding_after_contact']} at {speeds}); at "
           f"least {f['steps_at_U']:,} (v = U all along)")
+    cost = f["crown_cost"]
     print(f"  run time    ~{estimate.human_seconds(f['run_seconds_estimate'])} on the CPU of "
           f"BENCHMARKS.md (at least {estimate.human_seconds(f['run_seconds_at_U'])}): "
-          f"{tp.rate_total:.3g} particle-steps/s counting every particle, / "
-          f"{estimate.CROWN_COST:g} for a crown step, + {f['compile_seconds']:g} s compiling "
+          f"{tp.rate:.3g} fluid particle-steps/s (the bench), a crown step costing "
+          f"{cost['before_contact']:g} of it a fluid particle before contact and "
+          f"{cost['after_contact']:.3g} after (a wall or dummy particle "
+          f"{cost['wall_or_dummy']:g} of a fluid one), + {f['compile_seconds']:g} s compiling "
           f"(a first run; 3-9 s with the kernels in Taichi's cache)")
     left = f["left_out"] or ["nothing"]
     for i, line in enumerate(left):

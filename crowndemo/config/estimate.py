@@ -15,11 +15,22 @@ Figures measured on crown runs correct the bench:
   more as the spacing refines);
 - where the acoustic limit l0/c binds (c >= 10 U) the mean dt after contact is 0.88-0.95 of
   it (a few steps bound by a faster splash or the relative Courant limit): STEP_MIX;
-- a crown step costs about 0.8 of a bench step per particle, counting every particle (the
-  booth 3m-drop, `crowndemo bench --preset 3m-drop`: 643,033 particles x 1,442 steps in 286 s
-  = 3.2e6 particle-steps/s, against the bench's 2.6e6 at 300k; the floor's dummy particles
-  cost little). It was twice until the threads were balanced and the cell limit raised
-  (BENCHMARKS.md, 17:17 and 17:23 sections).
+- a crown step's cost per fluid particle, against the bench's per fluid particle (the tank
+  block's rate, BENCHMARKS.md), differs before and after contact: CALM_COST while the drop
+  falls onto a film at rest, SPLASH_COST after it, growing with the resolution as the splash
+  disorders the lattice and crowds the crown (the neighbour walks cost more at the same cell
+  side, BENCHMARKS.md "the cell grid of the splash"). A wall or dummy particle costs WALL_COST
+  of a fluid one (walls take part in the density walk, dummies only as neighbours). Measured
+  on the 2-core machine on 2026-12-02, each against the bench's rate measured next to it
+  (BENCHMARKS.md, "info's crown costs"; this host's speed moved by a third within that hour):
+  the seed rung of 3m-drop (1,227,236 fluid particles, a quarter on the plane floor) at 1.11 s
+  a step before contact and 1.74-1.80 s at 2 and 4 ms (`tools/snapshot_stages.py`) against
+  1.15-1.22e6 fluid particle-steps/s: 1.07 and 1.70; the booth 3m-drop (289,405 fluid) on its
+  particle floor (353,628 wall and dummy particles), 1,132 steps in 351.8 s, and on the plane
+  floor (72,720 in the side walls), 1,112 steps in 281.6 s (`crowndemo bench --preset 3m-drop
+  [--set numerics.wall_model=plane]`), against 1.12-1.15e6 just after them: solved for 0.25 a
+  wall or dummy particle and 0.93 after contact at D/l0 = 33, so the splash's cost grows as
+  (D/l0)^0.55. tests/test_estimate.py checks the run time of two other runs of that hour.
 
 ``steps_to_end`` gives both the floor (dt at v = U all along) and the expected count.
 """
@@ -47,7 +58,11 @@ SPLASH_AT_D_L0 = 30.0
 SPLASH_GROWTH = 0.36         # ... times (D/l0 / SPLASH_AT_D_L0)^this (6.2 U at D/l0 = 100)
 RELATIVE_SPEED_U = 1.5       # largest relative speed / U after contact (measured, see above)
 STEP_MIX = 0.9               # mean dt after contact / the smallest limit (measured, see above)
-CROWN_COST = 0.8             # a crown step's cost per particle / the bench's (measured)
+CALM_COST = 1.07             # a fluid particle-step before contact / the bench's (measured)
+SPLASH_COST = 1.70           # ... after contact at D/l0 = SPLASH_COST_AT (measured)
+SPLASH_COST_AT = 100.0
+SPLASH_COST_GROWTH = 0.55    # ... times (D/l0 / SPLASH_COST_AT)^this (0.93 at D/l0 = 33)
+WALL_COST = 0.25             # a wall or dummy particle-step / a fluid one (measured)
 # A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
 # (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
 # 2026-11-23, this CPU): 4.9 s in 2D, 51.5 s in 3D (13-19 s with --fast-compile, BENCHMARKS.md
@@ -225,21 +240,34 @@ def steps_to_end(r: Resolved) -> Dict:
         v_relative = RELATIVE_SPEED_U * r.speed
     after = timestep.choose(r.physics, r.numerics, r.model, v_splash, v_relative)
     dt_after = after[0] * (STEP_MIX if after[1] == "acoustic" else 1.0)
-    steps = math.ceil(contact / dt - 1e-9) + math.ceil((r.t_end - contact) / dt_after - 1e-9)
+    calm = math.ceil(contact / dt - 1e-9)
+    steps = calm + math.ceil((r.t_end - contact) / dt_after - 1e-9)
     return {"dt_s": dt, "binding": binding, "limits_s": lim,
             "steps_at_U": int(math.ceil(r.t_end / dt - 1e-9)) + frames,
             "splash_speed_m_s": v_splash, "relative_speed_m_s": v_relative,
             "dt_after_contact_s": dt_after,
-            "binding_after_contact": after[1], "steps": int(steps) + frames}
+            "binding_after_contact": after[1], "steps": int(steps) + frames,
+            "steps_before_contact": int(calm)}
 
 
-def run_seconds(total: int, steps: int, tp: Throughput, dim: int,
-                cost: float = CROWN_COST) -> float:
-    """A first run's compile (FIRST_RUN_COMPILE_S) + every particle (walls take part in the
-    neighbour walks) x steps at the bench's per-particle rate divided by the crown's cost
-    factor. 2D steps are taken to cost the 3D rate per particle (an upper figure: a 2D
-    particle has fewer neighbours)."""
-    return FIRST_RUN_COMPILE_S[dim] + total * steps * cost / tp.rate_total
+def crown_cost(drop_over_l0: float, splashing: bool) -> float:
+    """A crown step's cost per fluid particle / the bench's: CALM_COST before contact,
+    SPLASH_COST x (D/l0 / SPLASH_COST_AT)^SPLASH_COST_GROWTH after it (module docstring)."""
+    if not splashing:
+        return CALM_COST
+    return SPLASH_COST * (max(drop_over_l0, 1.0) / SPLASH_COST_AT) ** SPLASH_COST_GROWTH
+
+
+def run_seconds(counts: Dict, calm_steps: int, splash_steps: int, tp: Throughput, dim: int,
+                drop_over_l0: float) -> float:
+    """A first run's compile (FIRST_RUN_COMPILE_S) + the steps before and after contact, each
+    costing (fluid + WALL_COST x (wall + dummy)) particles at the bench's rate per fluid
+    particle times ``crown_cost`` of its phase. 2D steps are taken to cost the 3D rate per
+    particle (an upper figure: a 2D particle has fewer neighbours)."""
+    weighted = counts["fluid"] + WALL_COST * (counts.get("wall", 0) + counts.get("dummy", 0))
+    work = (calm_steps * crown_cost(drop_over_l0, False)
+            + splash_steps * crown_cost(drop_over_l0, True))
+    return FIRST_RUN_COMPILE_S[dim] + weighted * work / tp.rate
 
 
 def memory_bytes(total: int, tp: Throughput) -> float:
@@ -250,10 +278,17 @@ def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Di
     """Counts, steps, run time and memory of one preset at one quality."""
     counts = particle_counts(r, exact_up_to)
     st = steps_to_end(r)
-    secs = run_seconds(counts["total"], st["steps"], tp, r.dim)
+    d_l0 = r.scene["drop"] / r.l0
+    calm = st["steps_before_contact"]
+    secs = run_seconds(counts, calm, st["steps"] - calm, tp, r.dim, d_l0)
     return {"particles": counts, **st, "run_seconds": secs, "compile_seconds":
             FIRST_RUN_COMPILE_S[r.dim],
-            "run_seconds_at_U": run_seconds(counts["total"], st["steps_at_U"], tp, r.dim),
+            # a floor: the fewest steps, each at the cheaper of the two phases' costs
+            "run_seconds_at_U": run_seconds(
+                counts, *((st["steps_at_U"], 0) if crown_cost(d_l0, False) <= crown_cost(
+                    d_l0, True) else (0, st["steps_at_U"])), tp, r.dim, d_l0),
+            "crown_cost_calm": crown_cost(d_l0, False),
+            "crown_cost_splash": crown_cost(d_l0, True),
             "memory_bytes": memory_bytes(counts["total"], tp)}
 
 
@@ -283,5 +318,5 @@ def human_bytes(b: float) -> str:
 
 
 __all__ = ["Throughput", "throughput", "particle_counts", "steps_to_end", "splash_speed",
-           "run_seconds",
+           "crown_cost", "run_seconds",
            "memory_bytes", "summary", "human_seconds", "human_count", "human_bytes"]
