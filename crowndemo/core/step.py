@@ -220,14 +220,44 @@ class Simulator:
         """What a restarted run needs to take exactly the same path: the persistent particle
         fields in storage order (the re-sort depends on it), the health counters, the run
         statistics (``steps`` drives the re-sort schedule) and the last health report (its
-        max speed sets the next dt). The values of ``configure`` are not included."""
-        return {"particles": self.state.dump(), "health_counters": self.health.counters(),
-                "stats": copy.deepcopy(self.stats), "n_fluid": self.n_fluid}
+        max speed sets the next dt); and where the next predictor takes the density pass's
+        lists (terms.py), those lists and the mirror images they name. The values of
+        ``configure`` are not included."""
+        saved = {"particles": self.state.dump(), "health_counters": self.health.counters(),
+                 "stats": copy.deepcopy(self.stats), "n_fluid": self.n_fluid}
+        if self._lists_ready:
+            n = self.state.count
+            lists = self.pressure.neighbours
+            saved["lists"] = {"count": lists.count.to_numpy()[:n],
+                              "index": lists.index.to_numpy()[:n]}
+            if self.symmetry is not None:
+                m = int(self.state.n_images[None])
+                saved["lists"].update(source=self.symmetry.source.to_numpy()[n:n + m],
+                                      mask=self.symmetry.mask.to_numpy()[n:n + m])
+        return saved
 
     def restore_state(self, saved: dict) -> None:
         """Continue from ``save_state``'s result; call ``configure`` with the same values first."""
         self.state.restore(saved["particles"])
-        self._lists_ready = False       # the first step walks, as after the frame it saved at
+        self._lists_ready = False       # without saved lists the first step walks
+        lists = saved.get("lists")
+        if lists is not None and self.predictor.takes_list:
+            n = self.state.count
+            for field, values in ((self.pressure.neighbours.count, lists["count"]),
+                                  (self.pressure.neighbours.index, lists["index"])):
+                full = field.to_numpy()
+                full[:n] = values
+                field.from_numpy(full)
+            if self.symmetry is not None:
+                m = len(lists["source"])
+                for field, values in ((self.symmetry.source, lists["source"]),
+                                      (self.symmetry.mask, lists["mask"])):
+                    full = field.to_numpy()
+                    full[n:n + m] = values
+                    field.from_numpy(full)
+                self.state.n_images[None] = m
+                self.symmetry.sync_motion()      # the images' fields from their sources
+            self._lists_ready = True
         self.health.set_counters(saved["health_counters"])
         self.stats = copy.deepcopy(saved["stats"])
         self._last = self.stats.health

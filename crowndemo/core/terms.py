@@ -26,9 +26,10 @@ corrector's move brought within re: they lie within dt^2 |a'_i - a'_j| of re, wh
 (0.5 l0) none can be. Dummy particles are listed for it: only the collision model uses them,
 and without it fluid driven into a particle floor passes its wall layer (the booth 3m-drop
 went unstable at 2.7 ms, a number-density excess of 0.52). After a
-load, a restore and an output refresh (``Simulator.refresh_pressure``), and after a listing
-in which some particle had more neighbours than slots, the step walks the cells as without
-the option. Measured: BENCHMARKS.md, "the predictor's pairs from the list".
+load and an output refresh (``Simulator.refresh_pressure``), and after a listing in which
+some particle had more neighbours than slots, the step walks the cells as without the option;
+a saved state carries the lists (``Simulator.save_state``), so a restored run takes the same
+path. Measured: BENCHMARKS.md, "the predictor's pairs from the list".
 
 Why collisions (measured on the ``quick`` crown, 4 mm drop at 8 m/s, l0 = 0.4 mm): particles on
 the free surface have P = 0 (M3), so nothing repels two of them that approach; in the splash

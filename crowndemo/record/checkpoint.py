@@ -77,6 +77,7 @@ def save(path: PathLike, saved: dict, log: RunLog, next_frame: int, fingerprint:
     meta = {"format": FORMAT, "next_frame": next_frame, "fingerprint": fingerprint,
             "stats": _stats_json(stats), "n_fluid": saved["n_fluid"], "log": log.to_json()}
     arrays = {f"particles/{k}": v for k, v in saved["particles"].items()}
+    arrays.update({f"lists/{k}": v for k, v in saved.get("lists", {}).items()})
     arrays.update(health_counters=saved["health_counters"],
                   dt_log=np.asarray(stats.dt_log, dtype=np.float64),
                   bound_log=np.asarray(stats.bound_log, dtype=np.uint8),
@@ -113,6 +114,9 @@ def _read(path: Path) -> Checkpoint:
         saved = {"particles": particles, "health_counters": z["health_counters"],
                  "stats": _stats_from(meta["stats"], z["dt_log"], z["bound_log"], meta["log"]),
                  "n_fluid": meta["n_fluid"]}
+        lists = {k.split("/", 1)[1]: z[k] for k in z.files if k.startswith("lists/")}
+        if lists:           # the density pass's lists for the next predictor (Simulator)
+            saved["lists"] = lists
     return Checkpoint(saved, RunLog.from_json(meta["log"]), int(meta["next_frame"]),
                       meta["fingerprint"])
 
