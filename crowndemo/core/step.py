@@ -239,9 +239,10 @@ class Simulator:
     def restore_state(self, saved: dict) -> None:
         """Continue from ``save_state``'s result; call ``configure`` with the same values first."""
         self.state.restore(saved["particles"])
-        self._lists_ready = False       # without saved lists the first step walks
+        self._lists_ready = False       # without saved lists (of its slots) the first step walks
         lists = saved.get("lists")
-        if lists is not None and self.predictor.takes_list:
+        if (lists is not None and self.predictor.takes_list
+                and lists["index"].shape[1:] == (self.pressure.neighbours.slots,)):
             n = self.state.count
             for field, values in ((self.pressure.neighbours.count, lists["count"]),
                                   (self.pressure.neighbours.index, lists["index"])):
