@@ -281,14 +281,14 @@ def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Di
     d_l0 = r.scene["drop"] / r.l0
     calm = st["steps_before_contact"]
     secs = run_seconds(counts, calm, st["steps"] - calm, tp, r.dim, d_l0)
+    cost_calm, cost_splash = crown_cost(d_l0, False), crown_cost(d_l0, True)
+    # a floor: the fewest steps, each in the phase that costs less
+    fewest = st["steps_at_U"]
+    floor_steps = (fewest, 0) if cost_calm <= cost_splash else (0, fewest)
     return {"particles": counts, **st, "run_seconds": secs, "compile_seconds":
             FIRST_RUN_COMPILE_S[r.dim],
-            # a floor: the fewest steps, each at the cheaper of the two phases' costs
-            "run_seconds_at_U": run_seconds(
-                counts, *((st["steps_at_U"], 0) if crown_cost(d_l0, False) <= crown_cost(
-                    d_l0, True) else (0, st["steps_at_U"])), tp, r.dim, d_l0),
-            "crown_cost_calm": crown_cost(d_l0, False),
-            "crown_cost_splash": crown_cost(d_l0, True),
+            "run_seconds_at_U": run_seconds(counts, *floor_steps, tp, r.dim, d_l0),
+            "crown_cost_calm": cost_calm, "crown_cost_splash": cost_splash,
             "memory_bytes": memory_bytes(counts["total"], tp)}
 
 

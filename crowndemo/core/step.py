@@ -132,6 +132,13 @@ def max_particles(model: Model) -> int:
     return (FIELD_ENTRIES_MAX - 1) // entries_per_particle(model)
 
 
+def _put(field, start: int, values: np.ndarray) -> None:
+    """field[start : start + len(values)] = values (a Taichi field, the rest kept)."""
+    full = field.to_numpy()
+    full[start:start + len(values)] = values
+    field.from_numpy(full)
+
+
 class Simulator:
     """Holds one compiled step. ``configure`` changes run-time values without recompiling;
     the compiled terms (``Model``) are fixed at construction. Room for at least ``capacity``
@@ -244,19 +251,12 @@ class Simulator:
         if (lists is not None and self.predictor.takes_list
                 and lists["index"].shape[1:] == (self.pressure.neighbours.slots,)):
             n = self.state.count
-            for field, values in ((self.pressure.neighbours.count, lists["count"]),
-                                  (self.pressure.neighbours.index, lists["index"])):
-                full = field.to_numpy()
-                full[:n] = values
-                field.from_numpy(full)
+            _put(self.pressure.neighbours.count, 0, lists["count"])
+            _put(self.pressure.neighbours.index, 0, lists["index"])
             if self.symmetry is not None:
-                m = len(lists["source"])
-                for field, values in ((self.symmetry.source, lists["source"]),
-                                      (self.symmetry.mask, lists["mask"])):
-                    full = field.to_numpy()
-                    full[n:n + m] = values
-                    field.from_numpy(full)
-                self.state.n_images[None] = m
+                _put(self.symmetry.source, n, lists["source"])
+                _put(self.symmetry.mask, n, lists["mask"])
+                self.state.n_images[None] = len(lists["source"])
                 self.symmetry.sync_motion()      # the images' fields from their sources
             self._lists_ready = True
         self.health.set_counters(saved["health_counters"])
