@@ -62,9 +62,10 @@ class Pressure:
         list (terms.py) dummies are listed too: the collision model keeps fluid particles off
         them, and the corrector skips them."""
         acc.n += weight(ti.sqrt(r2), self.coef.re[None])
-        if ti.static(self.model.predictor_list):
-            acc.count = self.neighbours.add(i, j, acc.count)
-        elif self.state.kind[j] != DUMMY:
+        listed = True
+        if ti.static(not self.model.predictor_list):
+            listed = self.state.kind[j] != DUMMY
+        if listed:
             acc.count = self.neighbours.add(i, j, acc.count)
 
     @ti.func
@@ -144,10 +145,10 @@ class Pressure:
                         for m in range(self.neighbours.count[i]):
                             j = self.neighbours.index[i, m]
                             rij = self.state.pos[j] - xi
+                            used = True
                             if ti.static(self.model.predictor_list):   # dummies listed
-                                if self.state.kind[j] != DUMMY:
-                                    self._gradient_term(j, rij, rij.dot(rij), acc)
-                            else:
+                                used = self.state.kind[j] != DUMMY
+                            if used:
                                 self._gradient_term(j, rij, rij.dot(rij), acc)
                 if walk:
                     self.grid.for_each_neighbour(i, xi, self.coef.re2[None],

@@ -202,25 +202,25 @@ class Symmetry:
         n = self.state.n[None]
         for s in range(n, n + self.state.n_images[None]):
             i = self.source[s]
-            x, u = self.state.pos[i], self.state.vel[i]
-            for b in ti.static(range(len(self.planes))):
-                if self.mask[s] >> b & 1:
-                    x[self.planes[b]] = -x[self.planes[b]]
-                    u[self.planes[b]] = -u[self.planes[b]]
-            self.state.pos[s] = x
-            self.state.vel[s] = u
+            self.state.pos[s] = self._mirrored(self.state.pos[i], s)
+            self.state.vel[s] = self._mirrored(self.state.vel[i], s)
             self.state.kind[s] = self.state.kind[i]
+
+    @ti.func
+    def _mirrored(self, v, s):
+        """v reflected across the planes of image slot s (its run-time mask)."""
+        w = v
+        for b in ti.static(range(len(self.planes))):
+            if self.mask[s] >> b & 1:
+                w[self.planes[b]] = -w[self.planes[b]]
+        return w
 
     @ti.kernel
     def sync_velocity(self):
         """Images take their sources' (reflected) velocity: after u* (S15)."""
         n = self.state.n[None]
         for s in range(n, n + self.state.n_images[None]):
-            u = self.state.vel[self.source[s]]
-            for b in ti.static(range(len(self.planes))):
-                if self.mask[s] >> b & 1:
-                    u[self.planes[b]] = -u[self.planes[b]]
-            self.state.vel[s] = u
+            self.state.vel[s] = self._mirrored(self.state.vel[self.source[s]], s)
 
     @ti.kernel
     def sync_pressure(self):
