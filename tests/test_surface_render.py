@@ -91,6 +91,68 @@ def test_mesh_fields_have_headroom_and_grow_rarely():
     assert all(float(np.float32(x)) == x for piece in pieces for x in piece)   # exact in f32
 
 
+def uv_sphere(rings, radius):
+    """A closed UV sphere of ``rings`` rings (2 rings x rings quads): its mesh and its
+    outward normals."""
+    th, ph = np.meshgrid(np.linspace(0, np.pi, rings + 1),
+                         np.linspace(0, 2 * np.pi, 2 * rings + 1)[:-1], indexing="ij")
+    n = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
+    n = n.reshape(-1, 3)
+    m = 2 * rings
+    i, j = np.meshgrid(np.arange(rings), np.arange(m), indexing="ij")
+    a, b = i * m + j, i * m + (j + 1) % m
+    c, d = a + m, b + m
+    tris = np.concatenate([np.stack([a, c, b], -1), np.stack([b, c, d], -1)]).reshape(-1, 3)
+    from crowndemo.render.surface import SurfaceMesh
+    return SurfaceMesh(radius * n, tris, n.copy())
+
+
+def test_meshes_that_outgrow_their_fields_are_still_drawn(renderer):
+    """GGUI 1.7.4 on lavapipe drew nothing of a mesh whose buffers grew in 10-25 % of such
+    frames (meshbuffers.py). Balls that alternate between small and large (new fields every
+    frame, 30 frames), rendered through the renderer's check: every frame shows the ball
+    whole, at its size."""
+    pose = camera.spherical((0.0, 0.0, 0.0), 5.0, 30.0, 20.0, 40.0)
+    shown = []
+    for k, rings in enumerate([10, 200, 12, 300, 14, 250] * 5):
+        radius = 0.6 + 0.1 * (k % 2)
+        mesh = uv_sphere(rings, radius)
+        allocations = renderer.mesh_buffers.allocations if renderer.mesh_buffers else 0
+        img = renderer.render_surface(mesh, np.tile(np.float32(MILK), (mesh.n_vertices, 1)),
+                                      pose)
+        assert renderer.mesh_buffers.allocations > allocations        # new fields each time
+        lit = np.abs(img.astype(float) / 255 - np.array(SURFACE_BACKGROUND)).max(axis=2) > 2 / 255
+        r_px = camera.pixel_radius(pose, (0.0, 0.0, 0.0), radius, RES)
+        shown.append(lit.sum() / (np.pi * r_px ** 2))     # the ball's share of its disc
+    assert all(0.9 < x < 1.1 for x in shown), (shown, renderer.blank_retries)
+    assert renderer.blank_frames == 0
+
+
+def test_a_frame_drawn_blank_is_drawn_again(renderer, monkeypatch):
+    """The check itself: when GGUI leaves the mesh out of the first two draws of a frame
+    (forced here), render_surface sees the frame equal to the one without the mesh, draws it
+    again in new fields, and returns the ball; two redraws counted, none left blank."""
+    from crowndemo.render.renderer import Renderer as R
+    pose = camera.spherical((0.0, 0.0, 0.0), 5.0, 30.0, 20.0, 40.0)
+    mesh = uv_sphere(40, 0.6)
+    submit, dropped = R._submit_surface, []
+
+    def flaky(self, pose_, floor):
+        if self.drawn and self.mesh_buffers.n_indices > 3 and len(dropped) < 2:   # its mesh, twice
+            dropped.append(1)
+            drawn, self.drawn = self.drawn, 0
+            submit(self, pose_, floor)
+            self.drawn = drawn
+        else:
+            submit(self, pose_, floor)
+    monkeypatch.setattr(R, "_submit_surface", flaky)
+    img = renderer.render_surface(mesh, np.tile(np.float32(MILK), (mesh.n_vertices, 1)), pose)
+    assert len(dropped) == 2 and renderer.blank_retries == 2 and renderer.blank_frames == 0
+    lit = np.abs(img.astype(float) / 255 - np.array(SURFACE_BACKGROUND)).max(axis=2) > 2 / 255
+    r_px = camera.pixel_radius(pose, (0.0, 0.0, 0.0), 0.6, RES)
+    assert 0.9 < lit.sum() / (np.pi * r_px ** 2) < 1.1
+
+
 @pytest.fixture(scope="module")
 def quick(tmp_path_factory):
     """quick (draft) to 0.5 ms in the surface style, its frames and snapshots."""

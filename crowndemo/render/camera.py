@@ -49,8 +49,9 @@ class Geometry:
         """The box to keep in view: the drop at t = 0 and the crown by t_end, within the floor:
         out to 1.3 Yarin & Weiss base radii (the runs' crowns stand at 0.75-0.8 of it,
         VALIDATION.md crown-base: their spray has room) and up to that radius. A box half as
-        high (the rims stand at 0.25-0.3 of it) brings the camera closer, but recordings
-        with it drew frames without the liquid (issue 22's note): not adopted."""
+        high fits the coarse rungs (their rims stand at 0.25-0.3 of it) but not the seed
+        rung's, whose rim rose to 0.66 of it by 4 ms (18.7 mm, VALIDATION.md). (Frames drawn
+        without the liquid, once blamed on the lower box, were GGUI's: renderer._check_drawn.)"""
         rc = crown_base_radius(self.t_end - self.gap / self.speed, self.speed, self.drop,
                                self.film)
         half = min(max(FRAME_REACH * rc, 0.75 * self.drop), self.floor / 2)

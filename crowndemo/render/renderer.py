@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core.state import ParticleState
 from .buffers import ParticleBuffers
-from .camera import Pose
+from .camera import Pose, project
 from .colours import ColourScale
 from .floor import FloorMesh
 from .meshbuffers import MeshBuffers
@@ -33,6 +33,7 @@ SURFACE_AMBIENT = (0.16, 0.16, 0.16)
 KEY_LIGHT = (0.95, 0.93, 0.88)
 FILL_LIGHT = (0.30, 0.31, 0.34)
 KEY_TURN, KEY_RISE = 125.0, 40.0      # key light: degrees from the eye about the axis, above
+BLANK_RETRIES = 5     # a surface frame GGUI drew blank is drawn again (render_surface)
 
 
 class Renderer:
@@ -51,6 +52,9 @@ class Renderer:
         self.buffers: Optional[ParticleBuffers] = None
         self.mesh_buffers: Optional[MeshBuffers] = None
         self.drawn = 0                       # particles (triangles) drawn in the last frame
+        self.blank_retries = 0               # surface frames GGUI drew blank, drawn again
+        self.blank_frames = 0                # ... and still blank after BLANK_RETRIES
+        self._empty = None                   # (pose, floor) and its frame without the mesh
 
     def _buffers_for(self, capacity: int, planes: Sequence[int] = ()) -> ParticleBuffers:
         if (self.buffers is None or self.buffers.capacity < capacity
@@ -97,6 +101,51 @@ class Renderer:
                      floor: Optional[FloorMesh] = None) -> None:
         """Submit one frame: ``mesh`` (two-sided, its own normals) with per-vertex
         ``colours`` (V x 3 in 0..1), lit by the key and fill lights."""
+        if self.mesh_buffers is None:
+            self.mesh_buffers = MeshBuffers()
+        self.mesh_buffers.fill(mesh.vertices, mesh.triangles, mesh.normals, colours)
+        self.drawn = mesh.n_triangles
+        self._submit_surface(pose, floor)
+
+    def render_surface(self, mesh: SurfaceMesh, colours: np.ndarray, pose: Pose,
+                       floor: Optional[FloorMesh] = None) -> np.ndarray:
+        """``draw_surface`` and ``capture``, checked: GGUI 1.7.4 on lavapipe sometimes draws
+        nothing of the mesh (meshbuffers.py). A frame of a mesh in view that comes out the
+        same, pixel for pixel, as the frame without it is drawn again, its fields made anew
+        through a one-triangle mesh, at most BLANK_RETRIES times; counted in
+        ``blank_retries`` and, when every try came out blank, ``blank_frames``."""
+        self.draw_surface(mesh, colours, pose, floor)
+        img = self.capture()
+        if not self.drawn or not in_view(mesh.vertices, pose, self.resolution):
+            return img
+        empty = self._without_mesh(pose, floor)
+        for _ in range(BLANK_RETRIES):
+            if not np.array_equal(img, empty):
+                return img
+            self.blank_retries += 1
+            one = np.zeros((3, 3))
+            buf = self.mesh_buffers
+            buf.fill(one, np.array([[0, 1, 2]]), one, one, remake=True)
+            self._submit_surface(pose, floor)
+            self.capture()
+            buf.fill(mesh.vertices, mesh.triangles, mesh.normals, colours, remake=True)
+            self._submit_surface(pose, floor)
+            img = self.capture()
+        if np.array_equal(img, empty):
+            self.blank_frames += 1
+        return img
+
+    def _without_mesh(self, pose: Pose, floor: Optional[FloorMesh]) -> np.ndarray:
+        """The frame of ``pose`` with the ground and dish only (kept for the last pose)."""
+        key = (pose, id(floor))
+        if self._empty is None or self._empty[0] != key:
+            drawn, self.drawn = self.drawn, 0
+            self._submit_surface(pose, floor)
+            self._empty = (key, self.capture())
+            self.drawn = drawn
+        return self._empty[1]
+
+    def _submit_surface(self, pose: Pose, floor: Optional[FloorMesh]) -> None:
         scene = self.scene
         dist = self._set_camera(pose)
         scene.ambient_light(SURFACE_AMBIENT)
@@ -104,10 +153,7 @@ class Renderer:
             scene.point_light(_light_at(pose, dist, turn, rise), colour)
         if floor is not None:
             floor.draw(scene)
-        if self.mesh_buffers is None:
-            self.mesh_buffers = MeshBuffers()
         buf = self.mesh_buffers
-        self.drawn = buf.fill(mesh.vertices, mesh.triangles, mesh.normals, colours) // 3
         if self.drawn:
             for offset, count in buf.pieces():
                 scene.mesh(buf.vertices, buf.indices, buf.normals, per_vertex_color=buf.colours,
@@ -135,6 +181,16 @@ class Renderer:
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def in_view(points: np.ndarray, pose: Pose, resolution: Tuple[int, int],
+            sample: int = 20000) -> bool:
+    """Whether any of ``points`` (N x 3; at most ``sample`` of them, evenly taken) lands
+    inside the image, in front of the eye."""
+    px = project(pose, points[::max(1, len(points) // sample)], resolution)
+    w, h = resolution
+    return bool(np.any((px[:, 2] > 0) & (px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0)
+                       & (px[:, 1] < h)))
 
 
 def _light_at(pose: Pose, dist: float, turn: float, rise: float) -> Tuple[float, ...]:

@@ -6,7 +6,8 @@ file is written under a temporary name and renamed.
 
 It times itself: ``frame_seconds`` (surface, render, caption and PNG of each frame),
 ``render_seconds`` (their sum), ``surface_seconds`` (the surface reconstruction's part of it)
-and ``encode_seconds``, to set against the simulation's time per frame.
+and ``encode_seconds``, to set against the simulation's time per frame; and how often GGUI
+drew a surface blank and it was drawn again (``blank_redraws``; ``blank_frames``: still blank).
 """
 from __future__ import annotations
 
@@ -43,6 +44,8 @@ class FrameSink:
         if self.renderer.resolution != tuple(self.settings.resolution):
             raise ValueError(f"renderer of {self.renderer.resolution} for frames of "
                              f"{self.settings.resolution}")
+        # GGUI's blank surface frames drawn again (renderer._check_drawn), from here on
+        self._blank_start = (self.renderer.blank_retries, self.renderer.blank_frames)
         self.frame_seconds: List[float] = []
         self.surface_frame_seconds: List[float] = []
         self.encode_seconds = 0.0
@@ -122,6 +125,8 @@ class FrameSink:
                 "surface_seconds": surface,
                 "surface_seconds_per_frame": surface / n if n else 0.0,
                 "surface_triangles_last": self.view.triangles,
+                "blank_redraws": self.renderer.blank_retries - self._blank_start[0],
+                "blank_frames": self.renderer.blank_frames - self._blank_start[1],
                 "encode_seconds": self.encode_seconds}
 
 

@@ -125,8 +125,7 @@ class PresetView:
         """The uncaptioned frame of the surface of fluid particles ``pos`` with ``fields``."""
         mesh = self.surface(pos, fields)
         colours = vertex_colours(self.scale, mesh.vertices[:, 2], mesh.fields)
-        renderer.draw_surface(mesh, colours, pose, self.floor)
-        return renderer.capture()
+        return renderer.render_surface(mesh, colours, pose, self.floor)
 
 
 __all__ = ["RenderSettings", "PresetView", "SPHERE", "STYLES", "DEFAULT_STYLE",
