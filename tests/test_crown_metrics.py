@@ -272,6 +272,30 @@ def test_landed_spray_beyond_the_wall_is_not_the_base():
     assert m.crown, m.verdict
 
 
+def test_spray_over_the_far_film_is_not_its_surface():
+    """Droplets flying over the far film's ring (single particles 3 l0 apart in three layers
+    18-22 mm up, 3 % of the ring's particles: the seed rung at 3.5-4 ms put its 99th
+    percentile 23-27 mm up) leave the film's surface where it is and the crown measured as
+    without them."""
+    from crowndemo.validate.crown_metrics import film_edge
+    R, T, top, extent = 3.0e-3, 4 * L0, H + 2.0e-3, 8.0e-3
+    edge = film_edge(extent, L0)
+    base = np.concatenate([film(extent), shell(R, T, lambda t: top)])
+    g = np.arange(-extent, extent, 3 * L0)
+    x, y = (a.ravel() for a in np.meshgrid(g, g))
+    r = np.hypot(x, y)
+    ring = (r >= 0.75 * edge) & (r < edge)
+    spray = np.concatenate([np.c_[x[ring], y[ring], np.full(ring.sum(), H + z)]
+                            for z in (18e-3, 20e-3, 22e-3)])
+    in_ring = np.hypot(base[:, 0], base[:, 1])
+    assert len(spray) > 0.025 * np.count_nonzero((in_ring >= 0.75 * edge) & (in_ring < edge))
+    ref = measure(base, 1e-3, H, D, L0, edge=edge)
+    m = measure(np.concatenate([base, spray]), 1e-3, H, D, L0, edge=edge)
+    assert m.film_swell == 0.0 and ref.crown and m.crown
+    assert m.base_radius == ref.base_radius and m.rim_height == ref.rim_height
+    assert m.droplets == ref.droplets + len(spray)
+
+
 def test_a_swollen_film_is_the_film_not_raised_liquid():
     """The far film swollen by 3 l0 (every layer stretched, as the seed rung's film under the
     potential surface tension at D/l0 = 100): measured from the film's surface as it stands,
