@@ -16,7 +16,7 @@ INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finishe
 
 VALIDATE_EPILOG = """\
 examples:
-  crowndemo validate --quick                     # coarse resolutions, one variant each
+  crowndemo validate --quick                     # coarse resolutions, each variant once
   crowndemo validate                             # every case, every resolution and setting
   crowndemo validate dam-break-2d laplace-2d     # some cases
   crowndemo validate stability                   # the stiff and extreme cases only
@@ -299,8 +299,8 @@ def register(sub, common) -> None:
     p.add_argument("cases", nargs="*", metavar="CASE",
                    help="cases or groups to run (default: all; see --list)")
     p.add_argument("--quick", action="store_true",
-                   help="one coarse resolution and one settings variant per case (--list "
-                        "names it), stability to 0.4 ms, no 3m-drop crown and no verdicts "
+                   help="one coarse resolution and at most one settings variant per case "
+                        "(--list names it), stability to 0.4 ms, no 3m-drop crown and no verdicts "
                         "unless named; compiles as with --fast-compile unless "
                         "$CROWNDEMO_FAST_COMPILE is set")
     p.add_argument("--no-variants", action="store_true",
