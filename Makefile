@@ -69,7 +69,8 @@ demo: setup
 test: setup
 	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile -m "not slow"
 
-# The tests of minutes (pytest -m slow): the quarter crown against the whole run's quadrants.
+# The tests of minutes (pytest -m slow): the quarter crown against the whole run's quadrants,
+# the 3D cases of the predictor list (the 2D ones, in make test, take the same paths).
 test-slow: setup
 	$(PY) -m pytest -q -m slow
 

@@ -81,7 +81,7 @@ def missed_pair_terms(sim, pos, vel, kind, listed) -> tuple:
     return terms, nearest
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [2, pytest.param(3, marks=pytest.mark.slow)])   # 3D: a minute
 def test_listed_pairs_are_the_walk_less_the_pairs_moved_into_range(single_thread, dim):
     for name, scene in scenes(dim):
         sim = simulator_for(scene)
@@ -159,7 +159,7 @@ def test_off_walks_every_step(single_thread):
     assert not sim._lists_ready
 
 
-@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("dim", [2, pytest.param(3, marks=pytest.mark.slow)])   # 3D: a minute
 def test_a_state_saved_between_frames_continues_bit_for_bit(single_thread, dim):
     """A checkpoint taken when the next predictor takes the lists (Ctrl-C between frames)
     carries them, and the mirror images they name: a restored simulator takes the same path."""
