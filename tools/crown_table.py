@@ -7,9 +7,11 @@ film's edge from the scene's info), printed as VALIDATION.md's table of a seed-r
 The run's own metadata.json holds the metrics measured while it ran, with the rule of its
 start; this is how a table keeps up with a later fix of the rule (no Taichi here)."""
 import argparse
+import contextlib
 import glob
 import json
 import os
+import sys
 
 HEADER = ("| t (ms) | base r (mm) | rim h (mm) | rim thickness (mm) | jets | droplets | "
           "coherence | far film swell (mm) | verdict |\n"
@@ -25,10 +27,11 @@ def main() -> None:
     p.add_argument("recording", help="a recording's folder (metadata.json, snapshots/)")
     a = p.parse_args()
 
-    from crowndemo.core.state import FLUID
-    from crowndemo.record import snapshots
-    from crowndemo.validate.crown_metrics import measure
-    from crowndemo.validate.verdicts import film_limit
+    with contextlib.redirect_stdout(sys.stderr):      # Taichi's banner: the table alone on stdout
+        from crowndemo.core.state import FLUID
+        from crowndemo.record import snapshots
+        from crowndemo.validate.crown_metrics import measure
+        from crowndemo.validate.verdicts import film_limit
 
     with open(os.path.join(a.recording, "metadata.json")) as f:
         meta = json.load(f)
