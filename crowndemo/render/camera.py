@@ -50,8 +50,8 @@ class Geometry:
         out to 1.3 Yarin & Weiss base radii (the runs' crowns stand at 0.75-0.8 of it,
         VALIDATION.md crown-base: their spray has room) and up to that radius. A box half as
         high fits the coarse rungs (their rims stand at 0.25-0.3 of it) but not the seed
-        rung's, whose rim rose to 0.66 of it by 4 ms (18.7 mm, VALIDATION.md). (Frames drawn
-        without the liquid, once blamed on the lower box, were GGUI's: renderer._check_drawn.)"""
+        rung's, whose rim rose to 0.64 of it by 4 ms (18.2 mm, VALIDATION.md). (Frames drawn
+        without the liquid, once blamed on the lower box, were GGUI's: Renderer.render_surface.)"""
         rc = crown_base_radius(self.t_end - self.gap / self.speed, self.speed, self.drop,
                                self.film)
         half = min(max(FRAME_REACH * rc, 0.75 * self.drop), self.floor / 2)

@@ -44,7 +44,7 @@ class FrameSink:
         if self.renderer.resolution != tuple(self.settings.resolution):
             raise ValueError(f"renderer of {self.renderer.resolution} for frames of "
                              f"{self.settings.resolution}")
-        # GGUI's blank surface frames drawn again (renderer._check_drawn), from here on
+        # GGUI's blank surface frames drawn again (Renderer.render_surface), from here on
         self._blank_start = (self.renderer.blank_retries, self.renderer.blank_frames)
         self.frame_seconds: List[float] = []
         self.surface_frame_seconds: List[float] = []
