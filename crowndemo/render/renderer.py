@@ -137,8 +137,8 @@ class Renderer:
 
     def _without_mesh(self, pose: Pose, floor: Optional[FloorMesh]) -> np.ndarray:
         """The frame of ``pose`` with the ground and dish only (kept for the last pose)."""
-        key = (pose, id(floor))
-        if self._empty is None or self._empty[0] != key:
+        key = (pose, floor)                   # the floor by identity (FloorMesh has no __eq__)
+        if self._empty is None or self._empty[0][0] != pose or self._empty[0][1] is not floor:
             drawn, self.drawn = self.drawn, 0
             self._submit_surface(pose, floor)
             self._empty = (key, self.capture())
