@@ -4,8 +4,8 @@ GGUI copies the whole field every draw, so the fields follow the mesh's size).
 
 GGUI 1.7.4 on lavapipe sometimes draws nothing of a mesh: measured, growing spheres drawn
 offscreen at 320 x 180 came out blank in 10-25 % of the frames whose fields were made bigger
-(never in 128 frames where the vertex or the index count stayed the same). ``fill`` says
-when it made the fields anew (``remake`` forces it); ``Renderer.render_surface`` compares
+(never in 128 frames where the vertex or the index count stayed the same). ``fill`` with
+``remake`` makes the fields anew even for a mesh that fits; ``Renderer.render_surface`` compares
 each frame with the frame without the mesh and draws a blank one again in new fields. (A
 first check, an extra magenta draw and capture on frames with new fields, provoked more
 blanks than it caught: 9 of the first 13 frames of a 20cm-drop seed-rung recording; the
@@ -52,30 +52,20 @@ class MeshBuffers:
                 and n_vertices >= SHRINK * self.vertex_capacity)
 
     def fill(self, vertices: np.ndarray, triangles: np.ndarray, normals: np.ndarray,
-             colours: np.ndarray, remake: bool = False) -> bool:
-        """Copy one mesh in (``remake``: into new fields even if it fits); returns whether
-        the fields were made anew for it."""
+             colours: np.ndarray, remake: bool = False) -> None:
+        """Copy one mesh in (``remake``: into new fields even if it fits)."""
         nv, ni = len(vertices), 3 * len(triangles)
-        made = remake or not self._fits(nv, ni)
-        if made:
+        if remake or not self._fits(nv, ni):
             self._allocate(nv, ni)
-        for field, data in ((self.vertices, vertices), (self.normals, normals)):
-            self._put(field, data)
-        self.recolour(colours)
+        for field, data in ((self.vertices, vertices), (self.normals, normals),
+                            (self.colours, colours)):
+            pad = np.zeros((self.vertex_capacity, 3), np.float32)
+            pad[:nv] = data
+            field.from_numpy(pad)
         idx = np.zeros(self.index_capacity, np.int32)
         idx[:ni] = np.asarray(triangles, dtype=np.int64).reshape(-1)
         self.indices.from_numpy(idx)
         self.n_vertices, self.n_indices = nv, ni
-        return made
-
-    def recolour(self, colours: np.ndarray) -> None:
-        """New per-vertex colours for the mesh in the fields."""
-        self._put(self.colours, colours)
-
-    def _put(self, field, data: np.ndarray) -> None:
-        pad = np.zeros((self.vertex_capacity, 3), np.float32)
-        pad[:len(data)] = data
-        field.from_numpy(pad)
 
     def pieces(self) -> Iterator[Tuple[int, int]]:
         """(index offset, index count) of the draws that cover the mesh."""

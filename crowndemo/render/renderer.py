@@ -54,7 +54,7 @@ class Renderer:
         self.drawn = 0                       # particles (triangles) drawn in the last frame
         self.blank_retries = 0               # surface frames GGUI drew blank, drawn again
         self.blank_frames = 0                # ... and still blank after BLANK_RETRIES
-        self._empty = None                   # (pose, floor) and its frame without the mesh
+        self._empty = None                   # (pose, floor, its frame without the mesh)
 
     def _buffers_for(self, capacity: int, planes: Sequence[int] = ()) -> ParticleBuffers:
         if (self.buffers is None or self.buffers.capacity < capacity
@@ -137,13 +137,12 @@ class Renderer:
 
     def _without_mesh(self, pose: Pose, floor: Optional[FloorMesh]) -> np.ndarray:
         """The frame of ``pose`` with the ground and dish only (kept for the last pose)."""
-        key = (pose, floor)                   # the floor by identity (FloorMesh has no __eq__)
-        if self._empty is None or self._empty[0][0] != pose or self._empty[0][1] is not floor:
+        if self._empty is None or self._empty[0] != pose or self._empty[1] is not floor:
             drawn, self.drawn = self.drawn, 0
             self._submit_surface(pose, floor)
-            self._empty = (key, self.capture())
+            self._empty = (pose, floor, self.capture())     # the floor by identity
             self.drawn = drawn
-        return self._empty[1]
+        return self._empty[2]
 
     def _submit_surface(self, pose: Pose, floor: Optional[FloorMesh]) -> None:
         scene = self.scene
