@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Optional, Sequence, Tuple
 
 import numpy as np
 
-from . import camera
+from . import camera, still_film
 from .captions import CaptionInfo, draw_caption
 from .colours import DEFAULT_MODE, ColourScale, vertex_colours
 from .renderer import DEFAULT_RESOLUTION
@@ -47,6 +47,7 @@ class RenderSettings:
     video: bool = True           # encode video.mp4 and preview.gif when a recording closes
     fps: float = 12.0            # frames per second of the video
     style: str = DEFAULT_STYLE   # surface (the liquid, reconstructed) or particles (spheres)
+    still_film: bool = True      # 3D surface: the film at rest drawn flat (still_film.py)
 
     def __post_init__(self):
         if self.style not in STYLES:
@@ -114,8 +115,15 @@ class PresetView:
     def surface(self, pos: np.ndarray, fields: dict) -> SurfaceMesh:
         """The liquid surface of fluid particles (timed: ``surface_seconds``)."""
         start = _time.perf_counter()
-        mesh = reconstruct(pos, self.geometry.l0, fields, self.surface_params or SurfaceParams(),
-                           planes=self.planes)
+        g, params = self.geometry, self.surface_params or SurfaceParams()
+        if g.dim == 3 and self.settings.still_film and len(pos):
+            # the film at rest drawn flat (still_film.py): reconstruct the rest
+            cols = still_film.columns(pos, g.l0, g.film, params.band(g.l0), self.planes)
+            mesh = reconstruct(pos[cols.keep], g.l0, {k: v[cols.keep] for k, v in fields.items()},
+                               params, planes=self.planes)
+            mesh = still_film.join(mesh, cols)
+        else:
+            mesh = reconstruct(pos, g.l0, fields, params, planes=self.planes)
         self.surface_seconds = _time.perf_counter() - start
         self.triangles = mesh.n_triangles
         return mesh
