@@ -138,3 +138,39 @@ def test_a_quarter_is_mirrored_into_the_wholes_flat_film():
     flat_part, z_part = flat_triangles(part)
     assert flat_part == flat
     assert len(z_part) == 1 and abs(z_part[0] - z[0]) < 0.01       # l0: each its own median
+
+
+def test_a_trimmed_films_left_out_part_lies_flat_out_to_the_floors_edge():
+    """A film trimmed to a disc (scene.trim): the film left out is drawn as one flat ring at
+    the quads' height, from EDGE l0 inside the disc's edge out to the square floor's edge;
+    its area is the floor's less the inner polygon's, to rounding."""
+    pos = scene()
+    extent, floor = 45 * L0, 2 * HALF * L0
+    film = pos[:, 2] < FILM
+    pos = pos[~film | (np.hypot(pos[:, 0], pos[:, 1]) <= extent)]
+    cols = still_film.columns(pos, L0, FILM, PARAMS.band(L0), (), floor, extent)
+    mesh = reconstruct(pos[cols.keep], L0, {"speed": np.zeros(int(cols.keep.sum()))}, PARAMS)
+    joined = still_film.join(mesh, cols)
+    k = still_film.ANNULUS
+    ring = joined.vertices[joined.triangles[-2 * k:]]                # the ring comes last
+    r_in = extent - still_film.EDGE * L0
+    assert np.hypot(ring[..., 0], ring[..., 1]).min() == pytest.approx(r_in, rel=1e-12)
+    e1, e2 = ring[:, 1] - ring[:, 0], ring[:, 2] - ring[:, 0]
+    assert (np.cross(e1, e2)[:, 2] > 0).all()                       # facing up
+    area = 0.5 * np.cross(e1, e2)[:, 2].sum()
+    assert area == pytest.approx(floor ** 2 - 0.5 * k * r_in ** 2 * np.sin(2 * np.pi / k),
+                                 rel=1e-9)
+    up = np.all(joined.normals[joined.triangles] == [0.0, 0.0, 1.0], axis=(1, 2))
+    flat = joined.vertices[joined.triangles[up]]
+    assert len(flat) > 2 * k and np.ptp(flat[..., 2]) < 1e-12       # ring and quads: one height
+
+
+@pytest.mark.parametrize("preset, quality", [("quick", "draft"), ("3m-drop", "booth")])
+def test_the_view_knows_where_the_scene_trimmed_its_film(preset, quality):
+    """Geometry.film_extent is the radius the scene kept its film to, or None untrimmed."""
+    from crowndemo import config
+    from crowndemo.render.camera import Geometry
+    resolved = config.load(preset, quality)
+    info = resolved.build_scene().info
+    expect = info["extent_m"] if info["trimmed"] else None
+    assert Geometry.from_resolved(resolved).film_extent == expect

@@ -10,11 +10,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import TYPE_CHECKING, Sequence, Tuple
+from typing import TYPE_CHECKING, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..scenes.crown import crown_base_radius
+from ..scenes.crown import crown_base_radius, reach_radius
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -38,12 +38,16 @@ class Geometry:
     speed: float         # impact speed U
     t_end: float
     l0: float
+    film_extent: Optional[float] = None   # radius of the film simulated, when trimmed (3D)
 
     @classmethod
     def from_resolved(cls, resolved: Resolved) -> "Geometry":
         s = resolved.scene
+        reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"],
+                             s["trim_reach"])
+        trimmed = s["trim"] and reach < s["floor"] / 2 and resolved.dim == 3
         return cls(resolved.dim, s["drop"], s["film"], s["floor"], s["gap"], s["speed"],
-                   s["t_end"], resolved.l0)
+                   s["t_end"], resolved.l0, reach if trimmed else None)
 
     def frame_box(self) -> Tuple[np.ndarray, np.ndarray]:
         """The box to keep in view: the drop at t = 0 and the crown by t_end, within the floor:

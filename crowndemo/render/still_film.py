@@ -13,13 +13,16 @@ surface's band (SurfaceParams.band, the reach of its kernel and smoothing) of a 
 is not flat, so that the false edge where the film is left out lies a band beyond the mesh
 that is kept; the kept mesh covers the columns within KEEP of them, the quads the rest and one
 column under the mesh's edge (a hair under the mesh, which wins where both are).
-With symmetry planes the columns are laid from the planes, and the quads mirrored with the
-mesh."""
+A trimmed film (scene.trim) ends at a free edge that only the trimming made: the film left
+out beyond it lies at rest by construction (scenes/crown.py, reach_radius), so it is drawn as
+one flat ring at the same height, from a circle EDGE l0 inside the free edge (where the
+edge's rounding begins) out to the floor's edge, and the dish reads full of milk. With symmetry planes the columns are laid from the planes, and
+the quads mirrored with the mesh."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Dict, Sequence, Tuple
+from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -30,6 +33,10 @@ NEAR = 3.0      # particles below the film's top layer + NEAR l0 are the film's
 RAISED = 0.5    # a column whose highest film particle is this many l0 off the top layer moves
 KEEP = 2        # columns of flat film kept in the mesh around those that are not flat
 SINK = 0.02     # the quads lie this many l0 under the film top: the mesh wins where they meet
+EDGE = 5.0      # l0 inside a trimmed film's edge that the left-out film reaches
+ANNULUS = 512   # rays of the left-out film's mesh (a multiple of 8)
+TOP = 0.59      # the film top / l0 above the top layer where no flat film is kept in the
+                # mesh to measure it (a film of 3 layers reads 3.18 l0 thick, surface.py)
 
 
 @dataclass
@@ -44,6 +51,7 @@ class FilmColumns:
     top_layer: float            # the film's top particle layer, metres
     l0: float
     planes: Tuple[str, ...]
+    left_out: Optional[Tuple[float, float]] = None   # (floor side, film extent): trimmed
 
     def column_of(self, xy: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
         """Column indices of points (M x 2; folded across the planes) and whether inside."""
@@ -84,14 +92,22 @@ def _edge(filled: np.ndarray, axes: Tuple[int, ...]) -> np.ndarray:
 
 
 def columns(pos: np.ndarray, l0: float, film: float, band: float,
-            planes: Sequence[str] = ()) -> FilmColumns:
+            planes: Sequence[str] = (), floor: Optional[float] = None,
+            extent: Optional[float] = None) -> FilmColumns:
     """Classify the floor's columns for fluid particles ``pos`` (N x 3, metres) of a film of
-    thickness ``film`` and spacing ``l0``; ``band``: the surface's reach past a false edge."""
+    thickness ``film`` and spacing ``l0``; ``band``: the surface's reach past a false edge.
+    ``floor`` (the square floor's side) and ``extent`` (the radius of a trimmed film): the
+    film left out beyond it lies at rest and is drawn flat too (``join``)."""
     cell = CELL * l0
+    axes = plane_axes(planes)
     xy = pos[:, :2]
-    origin = np.floor(xy.min(axis=0) / cell) * cell
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    if floor is not None:
+        lo = np.minimum(lo, [0.0 if a in axes else -floor / 2 for a in (0, 1)])
+        hi = np.maximum(hi, floor / 2)
+    origin = np.floor(lo / cell) * cell
+    shape = tuple(int(v) for v in np.floor((hi - origin) / cell).astype(np.int64) + 1)
     ij = np.floor((xy - origin) / cell).astype(np.int64)
-    shape = tuple(int(v) for v in ij.max(axis=0) + 1)
     low = pos[:, 2] < film + NEAR * l0
     flat_index = np.ravel_multi_index((ij[:, 0], ij[:, 1]), shape)
     count = np.bincount(flat_index[low], minlength=shape[0] * shape[1]).reshape(shape)
@@ -101,7 +117,8 @@ def columns(pos: np.ndarray, l0: float, film: float, band: float,
     filled = count > 0
     top_layer = float(np.median(highest[filled])) if filled.any() else film
     level = np.abs(highest - top_layer) <= RAISED * l0
-    flat = filled & level & ~_edge(filled, plane_axes(planes))
+    edge = _edge(filled, axes)
+    flat = filled & level & ~edge
     moving = ~flat & filled
     k = int(math.ceil(band / cell))
     near_moving = _grow(moving, KEEP + k)
@@ -109,14 +126,15 @@ def columns(pos: np.ndarray, l0: float, film: float, band: float,
     column_kept = near_moving | ~flat
     keep = column_kept.reshape(-1)[flat_index] | ~low
     cut = flat & ~in_mesh
+    left_out = (floor, extent) if floor is not None and extent is not None else None
     return FilmColumns(keep, flat & _grow(cut, 1), cut, origin, cell, top_layer, l0,
-                       tuple(planes))
+                       tuple(planes), left_out)
 
 
 def join(mesh: SurfaceMesh, cols: FilmColumns) -> SurfaceMesh:
     """The reconstructed ``mesh`` (of the kept particles, mirrored where the run is) with the
     film over the flat columns cut away and drawn as quads at the mesh's own film top."""
-    if not cols.cut.any():
+    if not cols.flat.any() and cols.left_out is None:
         return mesh
     ij, inside = cols.column_of(mesh.vertices[:, :2])
     over_cut = inside & cols.cut[ij[:, 0], ij[:, 1]]
@@ -135,12 +153,31 @@ def join(mesh: SurfaceMesh, cols: FilmColumns) -> SurfaceMesh:
         top = float(np.median(mesh.vertices[on_kept, 2]))
         values = {k: float(np.median(v[on_kept])) for k, v in mesh.fields.items()}
     else:
-        top = cols.top_layer + 0.5 * cols.l0
+        top = cols.top_layer + TOP * cols.l0
         values = {k: 0.0 for k in mesh.fields}
     quads = _quads(cols, top - SINK * cols.l0, values)
     if cols.planes:
         quads = mirror(quads, cols.planes)
+    if cols.left_out is not None:
+        quads = _concatenate(quads, _annulus(*cols.left_out, cols.l0,
+                                             top - SINK * cols.l0, values))
     return _concatenate(kept, quads)
+
+
+def _annulus(floor: float, extent: float, l0: float, z: float,
+             values: Dict[str, float]) -> SurfaceMesh:
+    """The film left out of a trimmed run, at height ``z``: from EDGE l0 inside the
+    simulated film's edge (a circle) out to the square floor's edge, facing up."""
+    angle = np.arange(ANNULUS) * (2 * np.pi / ANNULUS)    # a multiple of 8: the corners
+    c, s = np.cos(angle), np.sin(angle)
+    out = 0.5 * floor / np.maximum(np.abs(c), np.abs(s))
+    inner = np.c_[(extent - EDGE * l0) * c, (extent - EDGE * l0) * s]
+    verts = np.c_[np.concatenate([inner, np.c_[out * c, out * s]]), np.full(2 * ANNULUS, z)]
+    a = np.arange(ANNULUS)
+    b = (a + 1) % ANNULUS
+    tris = np.concatenate([np.c_[a, b + ANNULUS, b], np.c_[a, a + ANNULUS, b + ANNULUS]])
+    normals = np.tile([0.0, 0.0, 1.0], (len(verts), 1))
+    return SurfaceMesh(verts, tris, normals, {k: np.full(len(verts), v) for k, v in values.items()})
 
 
 def _quads(cols: FilmColumns, z: float, values: Dict[str, float]) -> SurfaceMesh:

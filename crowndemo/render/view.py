@@ -118,7 +118,8 @@ class PresetView:
         g, params = self.geometry, self.surface_params or SurfaceParams()
         if g.dim == 3 and self.settings.still_film and len(pos):
             # the film at rest drawn flat (still_film.py): reconstruct the rest
-            cols = still_film.columns(pos, g.l0, g.film, params.band(g.l0), self.planes)
+            cols = still_film.columns(pos, g.l0, g.film, params.band(g.l0), self.planes,
+                                      g.floor, g.film_extent)
             mesh = reconstruct(pos[cols.keep], g.l0, {k: v[cols.keep] for k, v in fields.items()},
                                params, planes=self.planes)
             mesh = still_film.join(mesh, cols)
