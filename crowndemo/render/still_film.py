@@ -1,23 +1,24 @@
 """The film at rest drawn flat: columns of the film whose particles all sit at the film's own
 height are left out of the surface reconstruction and drawn as flat quads at the height the
-reconstruction gives the film top beside them. At booth quality two thirds of a late frame's
-triangles (1.0 of 1.5 million at 4 ms) are such flat film; the picture stays the same
-(tests/test_still_film.py compares the two).
+reconstruction gives the film top beside them. At booth quality that takes a frame's mesh
+from 0.68 to 0.13 million triangles at 0 ms, 1.00 to 0.57 at 2 ms, 1.50 to 1.15 at 4 ms, and
+no pixel changes by more than 8/255 (BENCHMARKS.md; tests/test_still_film.py compares them).
 
-Columns are squares of CELL l0 over the floor. A column's *film* particles are those below the
-film top + NEAR l0 (higher ones are spray or crown and are always reconstructed). A column is
-flat when it holds film particles, the highest of them lies within RAISED l0 of the film's top
-layer (the median of the columns' highest), and no column next to it is empty (the film's
-free edges stay reconstructed). The reconstruction takes every column within KEEP + the
-surface's band (SurfaceParams.band, the reach of its kernel and smoothing) of a column that
-is not flat, so that the false edge where the film is left out lies a band beyond the mesh
-that is kept; the kept mesh covers the columns within KEEP of them, the quads the rest and one
-column under the mesh's edge (a hair under the mesh, which wins where both are).
+Columns are squares of CELL l0 over the floor. A column's *film* particles are those below
+the film thickness h + NEAR l0 (higher ones are spray or crown and are always reconstructed).
+A column is flat when it holds film particles, the highest of them lies within RAISED l0 of
+the film's top layer (the median of the columns' highest), and no column next to it is
+empty (the film's free edges stay reconstructed). The reconstruction takes every column
+within KEEP + the surface's band (SurfaceParams.band, the reach of its kernel and smoothing)
+of a column that is not flat, so that the false edge where the film is left out lies a band
+beyond the mesh that is kept; the kept mesh covers the columns within KEEP of them, the
+quads the rest and one column under the mesh's edge (a hair under the mesh, which wins where
+both are).
 A trimmed film (scene.trim) ends at a free edge that only the trimming made: the film left
 out beyond it lies at rest by construction (scenes/crown.py, reach_radius), so it is drawn as
 one flat ring at the same height, from a circle EDGE l0 inside the free edge (where the
-edge's rounding begins) out to the floor's edge, and the dish reads full of milk. With symmetry planes the columns are laid from the planes, and
-the quads mirrored with the mesh."""
+edge's rounding begins) out to the floor's edge, and the dish reads full of milk. With
+symmetry planes the columns are laid from the planes, and the quads mirrored with the mesh."""
 from __future__ import annotations
 
 import math
@@ -29,7 +30,7 @@ import numpy as np
 from .surface import SurfaceMesh, mirror, plane_axes
 
 CELL = 4.0      # column side / l0
-NEAR = 3.0      # particles below the film's top layer + NEAR l0 are the film's
+NEAR = 3.0      # particles below the film's thickness h + NEAR l0 are the film's
 RAISED = 0.5    # a column whose highest film particle is this many l0 off the top layer moves
 KEEP = 2        # columns of flat film kept in the mesh around those that are not flat
 SINK = 0.02     # the quads lie this many l0 under the film top: the mesh wins where they meet
