@@ -181,13 +181,10 @@ def _rough_parts(r: Resolved) -> Dict:
     """Film, drop and wall-layer particles from the scene's sizes alone (volumes and floor
     area over l0^d), with the film's extent and whether it is trimmed."""
     from ..core.symmetry import fraction
-    from ..scenes.crown import reach_radius
+    from ..scenes.crown import film_extent
     s, d, l0 = r.scene, r.dim, r.l0
-    half = s["floor"] / 2
-    reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"],
-                         s["trim_reach"])
-    trimmed = s["trim"] and reach < half
-    e = reach if trimmed else half
+    e, trimmed = film_extent(s["floor"], s["trim"], s["t_end"], s["speed"], s["drop"],
+                             s["film"], s["gap"], s["trim_reach"])
     part = fraction(r.numerics.mirror_planes)     # a half or quarter run (core/symmetry.py)
     area = part * ((math.pi * e * e) if d == 3 else 2 * e)   # floor area (length in 2D)
     drop = part * (math.pi / 6 * s["drop"] ** 3 if d == 3 else math.pi / 4 * s["drop"] ** 2)

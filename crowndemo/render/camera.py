@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING, Optional, Sequence, Tuple
 
 import numpy as np
 
-from ..scenes.crown import crown_base_radius, reach_radius
+from ..scenes.crown import crown_base_radius, film_extent
 
 if TYPE_CHECKING:
     from ..config.resolve import Resolved
@@ -43,11 +43,10 @@ class Geometry:
     @classmethod
     def from_resolved(cls, resolved: Resolved) -> "Geometry":
         s = resolved.scene
-        reach = reach_radius(s["t_end"], s["speed"], s["drop"], s["film"], s["gap"],
-                             s["trim_reach"])
-        trimmed = s["trim"] and reach < s["floor"] / 2 and resolved.dim == 3
+        extent, trimmed = film_extent(s["floor"], s["trim"], s["t_end"], s["speed"], s["drop"],
+                                      s["film"], s["gap"], s["trim_reach"])
         return cls(resolved.dim, s["drop"], s["film"], s["floor"], s["gap"], s["speed"],
-                   s["t_end"], resolved.l0, reach if trimmed else None)
+                   s["t_end"], resolved.l0, extent if trimmed and resolved.dim == 3 else None)
 
     def frame_box(self) -> Tuple[np.ndarray, np.ndarray]:
         """The box to keep in view: the drop at t = 0 and the crown by t_end, within the floor:

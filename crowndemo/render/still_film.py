@@ -111,11 +111,10 @@ def columns(pos: np.ndarray, l0: float, film: float, band: float,
     ij = np.floor((xy - origin) / cell).astype(np.int64)
     low = pos[:, 2] < film + NEAR * l0
     flat_index = np.ravel_multi_index((ij[:, 0], ij[:, 1]), shape)
-    count = np.bincount(flat_index[low], minlength=shape[0] * shape[1]).reshape(shape)
     highest = np.full(shape[0] * shape[1], -np.inf)
     np.maximum.at(highest, flat_index[low], pos[low, 2])
     highest = highest.reshape(shape)
-    filled = count > 0
+    filled = highest > -np.inf
     top_layer = float(np.median(highest[filled])) if filled.any() else film
     level = np.abs(highest - top_layer) <= RAISED * l0
     edge = _edge(filled, axes)
@@ -156,13 +155,21 @@ def join(mesh: SurfaceMesh, cols: FilmColumns) -> SurfaceMesh:
     else:
         top = cols.top_layer + TOP * cols.l0
         values = {k: 0.0 for k in mesh.fields}
-    quads = _quads(cols, top - SINK * cols.l0, values)
+    z = top - SINK * cols.l0
+    quads = _quads(cols, z, values)
     if cols.planes:
         quads = mirror(quads, cols.planes)
     if cols.left_out is not None:
-        quads = _concatenate(quads, _annulus(*cols.left_out, cols.l0,
-                                             top - SINK * cols.l0, values))
+        quads = _concatenate(quads, _annulus(*cols.left_out, cols.l0, z, values))
     return _concatenate(kept, quads)
+
+
+def _facing_up(xy: np.ndarray, tris: np.ndarray, z: float,
+               values: Dict[str, float]) -> SurfaceMesh:
+    """A flat mesh at height ``z`` over the points ``xy``, facing up, with constant fields."""
+    verts = np.c_[xy, np.full(len(xy), z)]
+    return SurfaceMesh(verts, tris, np.tile([0.0, 0.0, 1.0], (len(xy), 1)),
+                       {k: np.full(len(xy), v) for k, v in values.items()})
 
 
 def _annulus(floor: float, extent: float, l0: float, z: float,
@@ -173,12 +180,10 @@ def _annulus(floor: float, extent: float, l0: float, z: float,
     c, s = np.cos(angle), np.sin(angle)
     out = 0.5 * floor / np.maximum(np.abs(c), np.abs(s))
     inner = np.c_[(extent - EDGE * l0) * c, (extent - EDGE * l0) * s]
-    verts = np.c_[np.concatenate([inner, np.c_[out * c, out * s]]), np.full(2 * ANNULUS, z)]
     a = np.arange(ANNULUS)
     b = (a + 1) % ANNULUS
     tris = np.concatenate([np.c_[a, b + ANNULUS, b], np.c_[a, a + ANNULUS, b + ANNULUS]])
-    normals = np.tile([0.0, 0.0, 1.0], (len(verts), 1))
-    return SurfaceMesh(verts, tris, normals, {k: np.full(len(verts), v) for k, v in values.items()})
+    return _facing_up(np.concatenate([inner, np.c_[out * c, out * s]]), tris, z, values)
 
 
 def _quads(cols: FilmColumns, z: float, values: Dict[str, float]) -> SurfaceMesh:
@@ -192,11 +197,9 @@ def _quads(cols: FilmColumns, z: float, values: Dict[str, float]) -> SurfaceMesh
     ys = cols.origin[1] + np.arange(ny + 1) * cols.cell
     corners = np.stack([np.c_[xs[i], ys[j]], np.c_[xs[i + 1], ys[j]],
                         np.c_[xs[i + 1], ys[j + 1]], np.c_[xs[i], ys[j + 1]]], 1)
-    verts = np.c_[corners.reshape(-1, 2), np.full(4 * len(i), z)]
     base = 4 * np.arange(len(i))[:, None]
     tris = np.concatenate([base + [0, 1, 2], base + [0, 2, 3]])
-    normals = np.tile([0.0, 0.0, 1.0], (len(verts), 1))
-    return SurfaceMesh(verts, tris, normals, {k: np.full(len(verts), v) for k, v in values.items()})
+    return _facing_up(corners.reshape(-1, 2), tris, z, values)
 
 
 def _concatenate(a: SurfaceMesh, b: SurfaceMesh) -> SurfaceMesh:

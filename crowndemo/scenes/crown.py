@@ -9,7 +9,7 @@ when their coefficients are zero (the compiled model drops them).
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Optional, Tuple
 
 import numpy as np
 
@@ -42,6 +42,16 @@ def reach_radius(t_end: float, U: float, D: float, h: float, gap: float,
     return max(factor * crown_base_radius(t_end - t_impact, U, D, max(h, 0.1 * D)), D) + 2.0e-3
 
 
+def film_extent(floor: float, trim: bool, t_end: float, U: float, D: float, h: float,
+                gap: float, factor: float = TRIM_REACH) -> Tuple[float, bool]:
+    """How far from the axis the film is built, and whether that is a trim: ``reach_radius``
+    when ``trim`` is asked and the reach lies inside the floor, else half the floor's side."""
+    half = floor / 2.0
+    reach = reach_radius(t_end, U, D, h, gap, factor)
+    trimmed = bool(trim and reach < half)
+    return (reach if trimmed else half), trimmed
+
+
 def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 1.0e-2,
           speed: float = 8.0, gap: float = 1.0e-3, floor: float = 0.09, t_end: float = 4.0e-3,
           trim: bool = True, numerics: Optional[Numerics] = None, rho: float = WATER["rho"],
@@ -57,9 +67,7 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     physics = Physics(dim=dim, l0=l0, v_max=speed, re_ratio=re_ratio, rho=rho, nu=nu,
                       sigma=sigma, gravity=gravity, sound_speed=sound_speed)
     half = floor / 2.0
-    reach = reach_radius(t_end, speed, drop, film, gap, trim_reach)
-    trimmed = trim and reach < half
-    extent = reach if trimmed else half
+    extent, trimmed = film_extent(floor, trim, t_end, speed, drop, film, gap, trim_reach)
     # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D)
     # on a plane's axis the lattice starts at the plane (0) instead of -extent
     side = lambda lo: [0.0 if a in planes else lo for a in range(dim - 1)]
