@@ -11,7 +11,7 @@ from crowndemo import config  # noqa: E402
 from crowndemo.cli import main  # noqa: E402
 from crowndemo.record import snapshots  # noqa: E402
 from crowndemo.render import camera, window  # noqa: E402
-from crowndemo.render.colours import MILK_HIGH, MILK_LOW  # noqa: E402
+from crowndemo.render.colours import COLOUR_MAP, MILK_HIGH, MILK_LOW, fields_read  # noqa: E402
 from crowndemo.render.meshbuffers import HEADROOM, MAX_INDICES, MeshBuffers  # noqa: E402
 from crowndemo.render.renderer import SURFACE_BACKGROUND, Renderer  # noqa: E402
 from crowndemo.render.surface import reconstruct  # noqa: E402
@@ -71,6 +71,33 @@ def test_ball_drawn_in_milk_where_it_projects(renderer):
     inside = dist < r_px - 2
     assert not bg[inside].any()                        # the whole disc is drawn
     assert milk_share(img, inside) > 0.95
+
+
+@pytest.mark.parametrize("colour", ["speed", "milk"])
+def test_surface_coloured_by_the_field_its_scale_reads(renderer, colour):
+    """A ball whose particles all move at the scale's top speed U, drawn by the preset view
+    (with its dish):
+    coloured by speed it is the colour map's top (red); in milk, milk (the view then leaves
+    the fields out of the reconstruction, which milk and height do not read)."""
+    r = config.load("quick", "draft")
+    view = PresetView.from_resolved(r, RenderSettings(resolution=RES, colour=colour))
+    centre = (0.0, 0.0, 12 * L0)
+    pos = ball(10, centre)
+    fields = {"speed": np.full(len(pos), r.speed), "pressure": np.zeros(len(pos))}
+    pose = camera.spherical(centre, 60 * L0, -60.0, 18.0, 35.0)
+    img = view.surface_image(renderer, pos, fields, pose).astype(float) / 255
+    cx, cy, _ = camera.project(pose, [centre], RES)[0]
+    rows, cols = np.mgrid[:RES[1], :RES[0]]
+    disc = np.hypot(cols + 0.5 - cx, rows + 0.5 - cy) < camera.pixel_radius(
+        pose, centre, 10 * L0, RES) - 2
+    bright = disc & (img.max(axis=2) > 0.15)        # the ball, not the dark dish behind it
+    assert bright.sum() > 0.5 * disc.sum()
+    if colour == "milk":
+        assert fields_read(colour) == () and milk_share(img, bright) > 0.95
+    else:
+        assert fields_read(colour) == ("speed",)
+        d = np.abs(chroma(img[bright]) - chroma(COLOUR_MAP[-1])).max(axis=1)
+        assert (d < 0.05).mean() > 0.95
 
 
 def test_mesh_fields_have_headroom_and_grow_rarely():

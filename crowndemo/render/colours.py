@@ -21,6 +21,14 @@ COLOUR_MAP = np.array([[0.15, 0.35, 0.85], [0.10, 0.70, 0.90], [0.35, 0.85, 0.45
 MILK_LOW = (0.86, 0.85, 0.81)      # milk at the floor
 MILK_HIGH = (1.00, 0.99, 0.95)     # milk at the top of the height scale
 UNITS = {"speed": "m/s", "height": "m", "pressure": "Pa", "milk": "m"}
+FIELD_MODES = ("speed", "pressure")   # modes read from a field interpolated to the vertices
+
+
+def fields_read(mode: str) -> tuple:
+    """The particle fields a surface coloured by ``mode`` needs at its vertices: height and
+    milk read the vertices' own height, so none (interpolating the two fields took ~40 % of
+    a booth frame's reconstruction, BENCHMARKS.md)."""
+    return (mode,) if mode in FIELD_MODES else ()
 
 
 @dataclass(frozen=True)
@@ -54,7 +62,7 @@ def colour_map(t: np.ndarray) -> np.ndarray:
 def vertex_colours(scale: ColourScale, height: np.ndarray, fields: dict) -> np.ndarray:
     """Per-vertex colours (V x 3 float32) of a surface: the mode's value from the fields
     interpolated to the vertices (speed, pressure) or the vertices' ``height``."""
-    value = np.asarray(fields[scale.mode] if scale.mode in ("speed", "pressure") else height,
+    value = np.asarray(fields[scale.mode] if scale.mode in FIELD_MODES else height,
                        float)
     span = scale.hi - scale.lo
     t = (value - scale.lo) / span if span > 0 else np.zeros_like(value)
@@ -64,5 +72,5 @@ def vertex_colours(scale: ColourScale, height: np.ndarray, fields: dict) -> np.n
     return colour_map(t).astype(np.float32)
 
 
-__all__ = ["MODES", "DEFAULT_MODE", "COLOUR_MAP", "MILK_LOW", "MILK_HIGH", "ColourScale",
+__all__ = ["MODES", "DEFAULT_MODE", "FIELD_MODES", "fields_read", "COLOUR_MAP", "MILK_LOW", "MILK_HIGH", "ColourScale",
            "colour_map", "vertex_colours"]

@@ -11,7 +11,7 @@ import numpy as np
 
 from . import camera, still_film
 from .captions import CaptionInfo, draw_caption
-from .colours import DEFAULT_MODE, ColourScale, vertex_colours
+from .colours import DEFAULT_MODE, ColourScale, fields_read, vertex_colours
 from .renderer import DEFAULT_RESOLUTION
 from .surface import SurfaceMesh, SurfaceParams, fluid_of, plane_axes, reconstruct
 
@@ -131,8 +131,9 @@ class PresetView:
 
     def surface_image(self, renderer: Renderer, pos: np.ndarray, fields: dict,
                       pose: camera.Pose) -> np.ndarray:
-        """The uncaptioned frame of the surface of fluid particles ``pos`` with ``fields``."""
-        mesh = self.surface(pos, fields)
+        """The uncaptioned frame of the surface of fluid particles ``pos`` with ``fields``
+        (only the one the colour scale reads goes to the reconstruction)."""
+        mesh = self.surface(pos, {k: fields[k] for k in fields_read(self.scale.mode)})
         colours = vertex_colours(self.scale, mesh.vertices[:, 2], mesh.fields)
         return renderer.render_surface(mesh, colours, pose, self.floor)
 
