@@ -89,9 +89,10 @@ def test_preset_far_too_fine_is_refused_before_its_scene_is_built():
 
 
 def test_info_says_when_a_preset_is_too_large(capsys):
+    # the whole thick layer at l0 = 70 um to its seed rung's 3 ms: ~51M particles (info)
     from crowndemo.cli import main
     assert main(["info", "thick-layer", "--quality", "seed", "--set",
-                 "quality.seed.l0=8e-5", *(a for w in WHOLE for a in ("--set", w))]) == 0
+                 "quality.seed.l0=7e-5", *(a for w in WHOLE for a in ("--set", w))]) == 0
     out = capsys.readouterr().out
     assert "too many" in out and "a run would be refused" in out
     assert main(["info", "thick-layer", "--quality", "seed", "--json"]) == 0
