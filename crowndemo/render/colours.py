@@ -72,5 +72,5 @@ def vertex_colours(scale: ColourScale, height: np.ndarray, fields: dict) -> np.n
     return colour_map(t).astype(np.float32)
 
 
-__all__ = ["MODES", "DEFAULT_MODE", "FIELD_MODES", "fields_read", "COLOUR_MAP", "MILK_LOW", "MILK_HIGH", "ColourScale",
-           "colour_map", "vertex_colours"]
+__all__ = ["MODES", "DEFAULT_MODE", "FIELD_MODES", "fields_read", "COLOUR_MAP", "MILK_LOW",
+           "MILK_HIGH", "ColourScale", "colour_map", "vertex_colours"]

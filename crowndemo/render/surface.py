@@ -202,7 +202,7 @@ def _smooth(out, particles: np.ndarray, l0: float, params: SurfaceParams) -> np.
         weights = grid_weights(particles, np.asarray(mesh.vertices), l0)
         pysplashsurf.laplacian_smoothing_parallel(out, connectivity, beta=1.0, weights=weights,
                                                   iterations=params.smoothing_iters)
-    normals = np.asarray(out.mesh.vertex_normals_parallel(), dtype=np.float64)
+    normals = np.asarray(mesh.vertex_normals_parallel(), dtype=np.float64)
     if params.normal_iters:
         pysplashsurf.laplacian_smoothing_normals_parallel(normals, connectivity,
                                                           iterations=params.normal_iters)
