@@ -60,15 +60,12 @@ def write(path: PathLike, mesh, time: Optional[float] = None) -> None:
 def surface_of(snap: Dict[str, np.ndarray], l0: float, planes: Sequence[str] = ()):
     """The surface of a snapshot's fluid particles, with speed and pressure on its vertices."""
     from ..core.state import FLUID
-    from ..render.surface import SurfaceParams, reconstruct
+    from ..render.surface import reconstruct
 
     fluid = np.asarray(snap["kind"]) == FLUID
     fields = {"speed": np.linalg.norm(np.asarray(snap["vel"])[fluid], axis=1),
               "pressure": np.asarray(snap["pressure"])[fluid]}
-    # splashsurf's own smoothing weights: the exported mesh of a mirrored run stays closed
-    # (the grid's weights left 4 open edges on the quarter quick's; the frames use those)
-    return reconstruct(np.asarray(snap["pos"])[fluid], l0, fields, planes=planes,
-                       params=SurfaceParams(weights="splashsurf"))
+    return reconstruct(np.asarray(snap["pos"])[fluid], l0, fields, planes=planes)
 
 
 def export(snapshot_files: Sequence[PathLike], out_dir: PathLike, name: str, l0: float,

@@ -38,6 +38,7 @@ from .smoothing_weights import grid_weights
 AXES = {"x": 0, "y": 1}
 SLICE_LAYERS = 3            # layers (l0 apart along y) a 2D slice is extruded into
 WEIGHTS = ("grid", "splashsurf")
+SNAP_CUBES = 1.0e-6         # a vertex this close to a plane (in cubes) lies on it (rounding)
 
 
 @dataclass(frozen=True)
@@ -186,7 +187,7 @@ def reconstruct(pos: np.ndarray, l0: float, fields: Optional[Mapping[str, np.nda
                        {k: np.asarray(attrs[k], dtype=np.float64) for k in values})
     if not axes:
         return mesh
-    mesh = _cut(mesh, axes)
+    mesh = _cut(mesh, axes, snap=SNAP_CUBES * params.cube_size(l0))
     return mirror(mesh, planes) if whole else mesh
 
 
@@ -210,11 +211,18 @@ def _smooth(out, particles: np.ndarray, l0: float, params: SurfaceParams) -> np.
     return np.where(length > 0, normals / np.where(length > 0, length, 1.0), 0.0)
 
 
-def _cut(mesh: SurfaceMesh, axes: Tuple[int, ...]) -> SurfaceMesh:
+def _cut(mesh: SurfaceMesh, axes: Tuple[int, ...], snap: float = 0.0) -> SurfaceMesh:
     """The mesh cut at the planes (as splashsurf's mesh AABB does, but after its smoothing,
-    which then saw both sides): triangles wholly beyond a plane dropped, the vertices of the
-    others beyond it moved onto it; on a plane a normal loses its component across it."""
+    which then saw both sides): vertices within ``snap`` (metres) of a plane put on it (the
+    smoothing's rounding), triangles wholly beyond a plane dropped, the vertices of the others
+    beyond it moved onto it; on a plane a normal loses its component across it."""
     ax = list(axes)
+    near = np.abs(mesh.vertices[:, ax]) <= snap
+    if near.any():
+        mesh = replace(mesh, vertices=mesh.vertices.copy())
+        sub = mesh.vertices[:, ax]
+        sub[near] = 0.0
+        mesh.vertices[:, ax] = sub
     inside = np.all(mesh.vertices[:, ax] > 0.0, axis=1)
     tris = mesh.triangles[inside[mesh.triangles].any(axis=1)]
     used = np.unique(tris)
