@@ -141,6 +141,26 @@ def test_preset_symmetry_key():
         config.load("3m-drop", "draft", ["scene.symmetry=eighth"])
 
 
+@pytest.mark.parametrize("dim,symmetry,wall_model,trim",
+                         [(3, "quarter", "plane", True), (3, "quarter", "particles", True),
+                          (3, "quarter", "particles", False), (2, "half", "particles", True)])
+def test_whole_crown_scene_is_its_mirrored_part(dim, symmetry, wall_model, trim):
+    # the whole scene's lattice lies at +-(k + 1/2) l0 from the axis, so the whole scene and
+    # its part mirrored are the same particles (fluid and floor): a whole run then starts as
+    # symmetric as the part's mirror images make the part's run
+    from crowndemo.scenes import crown
+    args = dict(dim=dim, l0=4.7e-4, numerics=Numerics(wall_model=wall_model), trim=trim,
+                floor=0.09 if trim else 0.03)      # untrimmed: side walls on every face
+    whole, part = crown(**args), crown(symmetry=symmetry, **args)
+    planes = planes_of(symmetry, dim)
+    as_set = lambda pos, kind: {tuple(np.round(x / 4.7e-4, 6)) + (k,)
+                                for x, k in zip(pos, kind)}
+    mirrored = mirror_whole({"pos": part.pos, "kind": part.kind}, planes)
+    assert len(whole.pos) == len(mirrored["pos"]) == 2 ** len(planes) * len(part.pos)
+    assert as_set(whole.pos, whole.kind) == as_set(mirrored["pos"], mirrored["kind"])
+    assert whole.info["n_drop"] == 2 ** len(planes) * part.info["n_drop"]
+
+
 def test_snapshots_and_vtk_say_the_run_is_a_part(tmp_path):
     from crowndemo.record import snapshots, vtk
     n = 5

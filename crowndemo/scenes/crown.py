@@ -61,24 +61,30 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     """Drop on a film. ``floor`` is the side of the square container floor (the width of the
     slice in 2D); the axis of the drop is x = 0 (and y = 0), the floor surface z = 0.
     ``symmetry``: the whole scene (full), or the part x > 0 (half), or x > 0, y > 0 (quarter,
-    3D) with mirror planes through the axis (core/symmetry.py); the lattice then lies at
-    (k + 1/2) l0 from the planes, so that its mirror images continue it."""
+    3D) with mirror planes through the axis (core/symmetry.py). Across the floor the lattice
+    lies at +-(k + 1/2) l0 from the axis whatever the symmetry, so that the part's mirror
+    images continue it and the whole scene is the mirrored quarter, particle for particle."""
     planes = planes_of(symmetry, dim)
     physics = Physics(dim=dim, l0=l0, v_max=speed, re_ratio=re_ratio, rho=rho, nu=nu,
                       sigma=sigma, gravity=gravity, sound_speed=sound_speed)
     half = floor / 2.0
     extent, trimmed = film_extent(floor, trim, t_end, speed, drop, film, gap, trim_reach)
-    # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D)
-    # on a plane's axis the lattice starts at the plane (0) instead of -extent
-    side = lambda lo: [0.0 if a in planes else lo for a in range(dim - 1)]
-    film_pts = lattice_block(side(-extent) + [0.0], [extent] * (dim - 1) + [film], l0)
+    # the film: the lattice over the floor, cut to a disc of radius `extent` when trimmed (3D).
+    # Across the floor a box of half-width w starts at the plane (0) on a plane's axis, else at
+    # -k l0 with k = floor(w / l0): its points +-(k + 1/2) l0 are symmetric about the axis, and
+    # film, drop and floor lie on one lattice (the floor's side walls at +-k l0, within l0 of w)
+    cells = lambda w: math.floor(w / l0 + 1.0e-9)
+    side = lambda w: [0.0 if a in planes else -cells(w) * l0 for a in range(dim - 1)]
+    reach = cells(extent) * l0
+    film_pts = lattice_block(side(extent) + [0.0], [reach] * (dim - 1) + [film], l0)
     if trimmed and dim == 3:
         film_pts = film_pts[np.linalg.norm(film_pts[:, :2], axis=1) <= extent]
     # the drop: lattice points inside the sphere (disc), its bottom `gap` above the film
     radius = drop / 2.0
     centre_z = film + gap + radius
-    box = lattice_block(side(-radius) + [centre_z - radius],
-                        [radius] * (dim - 1) + [centre_z + radius], l0)
+    across = math.ceil(radius / l0 - 1.0e-9) * l0       # every lattice point within the sphere
+    box = lattice_block(side(across) + [centre_z - radius],
+                        [across] * (dim - 1) + [centre_z + radius], l0)
     rel = box - np.array([0.0] * (dim - 1) + [centre_z])
     drop_pts = box[np.linalg.norm(rel, axis=1) <= radius]
     fluid = np.concatenate([film_pts, drop_pts])
@@ -93,8 +99,8 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
     faces = [f for f in faces if f not in beyond_planes]
     faces = particle_faces(faces, dim, numerics)
     wall_top = film + 0.5 * drop
-    floor_lo = side(-extent - (0 if not trimmed else layers * l0)) + [0.0]
-    floor_hi = [extent + (0 if not trimmed else layers * l0)] * (dim - 1) + [wall_top]
+    floor_lo = side(reach + (0 if not trimmed else layers * l0)) + [0.0]
+    floor_hi = [reach + (0 if not trimmed else layers * l0)] * (dim - 1) + [wall_top]
     walls = container_walls(floor_lo, floor_hi, l0, layers, faces) if faces else None
     if walls is not None and trimmed and dim == 3:   # the disc under the film, a rim `layers` wide
         keep = np.linalg.norm(walls[0][:, :2], axis=1) <= extent + layers * l0
