@@ -185,31 +185,62 @@ def _quadrants(pos: np.ndarray):
             yield q * np.array([sx, sy, 1.0])
 
 
+def _crown_run(symmetry: str, stops: tuple, at: float):
+    """3m-drop at draft to 2 ms, whole or quarter, its step sequence cut by frame ``stops``:
+    the metrics (base radius, rim height, particles) of each quadrant mirrored into a whole
+    crown, and the fluid's positions at time ``at`` keyed by their start on the lattice."""
+    from crowndemo.validate.crown_metrics import measure
+    r = config.load("3m-drop", "draft", [f"scene.symmetry={symmetry}"])
+    sim = simulator_for(r.build_scene())
+    key = lambda p: map(tuple, np.rint(p / r.l0 * 2).astype(int))
+    start = sim.snapshot()
+    starts = dict(zip(start["id"].tolist(), key(start["pos"])))
+    early = {}
+
+    def keep(sim, index):
+        s = sim.snapshot()
+        if abs(sim.stats.time - at) < 1e-12:
+            f = s["kind"] == FLUID
+            early.update(zip((starts[i] for i in s["id"][f].tolist()), s["pos"][f]))
+    sim.run(r.t_end, sorted({at, *stops}), keep)
+    assert sim.stats.health.left_total == 0
+    snap = sim.snapshot()
+    pos = snap["pos"][snap["kind"] == FLUID]
+    parts = [pos] if symmetry == "quarter" else list(_quadrants(pos))
+    metrics = [measure(mirror_whole({"pos": q}, (0, 1))["pos"], r.t_end, r.scene["film"],
+                       r.scene["drop"], r.l0) for q in parts]
+    return [(m.base_radius, m.rim_height, len(q)) for m, q in zip(metrics, parts)], early, r.l0
+
+
 @pytest.mark.slow
 def test_quarter_crown_within_the_whole_runs_quadrant_spread():
-    # 3m-drop at draft (D/l0 = 30, to 2 ms), whole and quarter. Each quadrant of the whole run,
-    # mirrored into a whole crown, gives a base radius, rim height and mass; the quarter run's
-    # must lie no farther from their mean than the farthest quadrant does (issue 21). About
-    # 5 minutes on 2 cores: `make test-slow` runs it, `make test` leaves it out.
-    from crowndemo.validate.crown_metrics import measure
-    seen = {}
-    for symmetry in ("quarter", "full"):
-        r = config.load("3m-drop", "draft", [f"scene.symmetry={symmetry}"])
-        sim = simulator_for(r.build_scene())
-        sim.run(r.t_end)
-        snap = sim.snapshot()
-        pos = snap["pos"][snap["kind"] == FLUID]
-        parts = [pos] if symmetry == "quarter" else list(_quadrants(pos))
-        seen[symmetry] = []
-        for q in parts:
-            m = measure(mirror_whole({"pos": q}, (0, 1))["pos"], r.t_end, r.scene["film"],
-                        r.scene["drop"], r.l0)
-            seen[symmetry].append((m.base_radius, m.rim_height, len(q)))
-        assert sim.stats.health.left_total == 0
-    quadrants, quarter = np.array(seen["full"]), np.array(seen["quarter"][0])
+    # 3m-drop at draft (D/l0 = 30, to 2 ms), whole and quarter (issue 21; docs/symmetry.md,
+    # "The quarter against the whole"). The splash is chaotic: the whole run's own mirror
+    # twins, equal at the start, drift apart from round-off (1e-7 l0 at 0.05 ms) to l0 by 1 ms,
+    # and the quarter drifts from the whole's quadrant no faster. So:
+    # 1. before the drift grows (0.2 ms) the quarter is the whole's quadrant particle for
+    #    particle, within 0.01 l0 (a missing or wrong mirror image moves a particle near a
+    #    plane by a fair part of l0 in a few steps);
+    # 2. at 2 ms a run is one sample of the chaos, and the crown metrics are not smooth in the
+    #    positions (a sector's highest particle is in the rim or not by a link of 1.6 l0): two
+    #    whole runs, their steps cut apart by a frame stop at 0.35 ms, give 8 quadrants; the
+    #    mean of two quarter runs cut the same ways must lie no farther from the quadrants'
+    #    mean than the farthest quadrant does. About 7 minutes on 2 cores: `make test-slow`
+    #    runs it, `make test` leaves it out.
+    at, members = 2.0e-4, ((), (3.5e-4,))
+    quadrants, quarters = [], []
+    for stops in members:
+        q, q_early, l0 = _crown_run("quarter", stops, at)
+        w, w_early, _ = _crown_run("full", stops, at)
+        quarters += q
+        quadrants += w
+        if not stops:
+            moved = [np.linalg.norm(p - w_early[k]) for k, p in q_early.items()]
+            assert len(moved) == len(q_early) and max(moved) < 0.01 * l0, max(moved) / l0
+    quadrants, quarter = np.array(quadrants), np.array(quarters).mean(axis=0)
     mean = quadrants.mean(axis=0)
     spread = np.abs(quadrants - mean).max(axis=0)
-    assert np.all(np.abs(quarter - mean) <= spread), (quarter, quadrants)
+    assert np.all(np.abs(quarter - mean) <= spread), (quarters, quadrants)
 
 
 def test_particle_frames_draw_the_whole_of_a_quarter():

@@ -1,6 +1,6 @@
 """The symmetry-plane and trim measurements of docs/symmetry.md, reproducible:
 
-    .venv/bin/python tools/symmetry_study.py tank|dam|crown2d|quarter|trim
+    .venv/bin/python tools/symmetry_study.py tank|dam|crown2d|quarter|twins|trim
 
 Each prints the figures that docs/symmetry.md quotes: a part of a symmetric scene against the
 whole (core/symmetry.py), and the film's speed profile of an untrimmed 2D crown (the trim)."""
@@ -58,20 +58,64 @@ def crown2d() -> None:
 
 
 def quarter(preset: str = "3m-drop") -> None:
+    """Two whole and two quarter runs at draft to t_end, the second of each with its steps cut
+    by a frame stop at 0.35 ms (tests/test_symmetry.py's ensemble)."""
+    seen = {"quarter": [], "full": []}
+    for stops in ((), (3.5e-4,)):
+        for sym in ("quarter", "full"):
+            r = config.load(preset, "draft", [f"scene.symmetry={sym}"])
+            sim = simulator_for(r.build_scene())
+            sim.run(r.t_end, frame_times=stops)
+            snap = sim.snapshot()
+            pos = snap["pos"][snap["kind"] == FLUID]
+            parts = [pos] if sym == "quarter" else [
+                pos[(sx * pos[:, 0] > 0) & (sy * pos[:, 1] > 0)] * np.array([sx, sy, 1])
+                for sx in (1, -1) for sy in (1, -1)]
+            for q in parts:
+                m = measure(mirror_whole({"pos": q}, (0, 1))["pos"], r.t_end, r.scene["film"],
+                            r.scene["drop"], r.l0)
+                seen[sym].append((m.base_radius * 1e3, m.rim_height * 1e3, len(q)))
+                print(f"{sym} (stops {stops}): base {m.base_radius * 1e3:.2f} mm, rim "
+                      f"{m.rim_height * 1e3:.2f} mm, {len(q)} fluid particles "
+                      f"({sim.stats.steps} steps)", flush=True)
+    quads, quarter = np.array(seen["full"]), np.array(seen["quarter"]).mean(axis=0)
+    mean = quads.mean(axis=0)
+    print("quadrants' mean", np.round(mean, 3), "largest deviation",
+          np.round(np.abs(quads - mean).max(axis=0), 3), "; quarters' mean", np.round(quarter, 3),
+          "deviation", np.round(np.abs(quarter - mean), 3))
+
+
+def twins() -> None:
+    """The drift of the splash: the quarter against the whole's quadrant +x +y, particle for
+    particle (matched by their start on the lattice), beside the whole's own mirror twins
+    (its quadrant +x +y against the other three mirrored), in l0, at frame times."""
+    times = [5e-5, 1e-4, 2e-4, 4e-4, 7e-4, 1e-3, 1.5e-3, 2e-3]
+    runs = {}
     for sym in ("quarter", "full"):
-        r = config.load(preset, "draft", [f"scene.symmetry={sym}"])
+        r = config.load("3m-drop", "draft", [f"scene.symmetry={sym}"])
         sim = simulator_for(r.build_scene())
-        sim.run(r.t_end)
-        snap = sim.snapshot()
-        pos = snap["pos"][snap["kind"] == FLUID]
-        parts = [pos] if sym == "quarter" else [
-            pos[(sx * pos[:, 0] > 0) & (sy * pos[:, 1] > 0)] * np.array([sx, sy, 1])
-            for sx in (1, -1) for sy in (1, -1)]
-        for q in parts:
-            m = measure(mirror_whole({"pos": q}, (0, 1))["pos"], r.t_end, r.scene["film"],
-                        r.scene["drop"], r.l0)
-            print(f"{sym}: base {m.base_radius * 1e3:.2f} mm, rim {m.rim_height * 1e3:.2f} mm, "
-                  f"{len(q)} fluid particles ({sim.stats.steps} steps)")
+        s0 = sim.snapshot()
+        keys = map(tuple, np.rint(s0["pos"] / r.l0 * 2).astype(int))   # on the half-l0 grid
+        start = dict(zip(s0["id"].tolist(), keys))
+        frames = runs[sym] = []
+
+        def keep(s, i):
+            snap = s.snapshot()
+            f = snap["kind"] == FLUID
+            frames.append(dict(zip((start[k] for k in snap["id"][f].tolist()), snap["pos"][f])))
+        sim.run(times[-1], times, keep)
+    for t, q, w in zip(times, runs["quarter"], runs["full"]):
+        to_quarter, twin = [], []
+        for k, p in q.items():
+            to_quarter.append(np.linalg.norm(p - w[k]))
+            for sx, sy in ((-1, 1), (1, -1), (-1, -1)):
+                mirrored = w.get((sx * k[0], sy * k[1], k[2]))
+                if mirrored is not None:
+                    twin.append(np.linalg.norm(w[k] - mirrored * np.array([sx, sy, 1.0])))
+        pct = lambda a: " ".join(f"{v:.1e}" for v in np.percentile(np.array(a) / r.l0,
+                                                                    (50, 90, 99, 100)))
+        print(f"t = {t * 1e3:.2f} ms; [l0] 50/90/99/100th percentiles: quarter against the "
+              f"whole {pct(to_quarter)}; whole's twins {pct(twin)}")
 
 
 def trim() -> None:
@@ -96,6 +140,6 @@ def trim() -> None:
 if __name__ == "__main__":
     backend.init("cpu")
     t0 = time.perf_counter()
-    {"tank": tank, "dam": dam, "crown2d": crown2d, "quarter": quarter, "trim": trim}[
-        sys.argv[1]](*sys.argv[2:])
+    {"tank": tank, "dam": dam, "crown2d": crown2d, "quarter": quarter, "twins": twins,
+     "trim": trim}[sys.argv[1]](*sys.argv[2:])
     print(f"({time.perf_counter() - t0:.0f} s)")
