@@ -66,8 +66,11 @@ demo: setup
 
 # One pytest-xdist worker per core (at most 4), each test file on one worker: most of the
 # suite's time is compiling kernels, one core per process, and a file's tests share them.
+# CROWNDEMO_FAST_COMPILE=1: Taichi's advanced IR optimisations off on the CPU, the same
+# equations compiled ~3x faster (BENCHMARKS.md, "Compiling"); tests that need the default
+# compile set it themselves (test_backend.py), and `make test-slow` compiles as users do.
 test: setup
-	$(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile -m "not slow"
+	CROWNDEMO_FAST_COMPILE=1 $(PY) -m pytest -q -n auto --maxprocesses 4 --dist loadfile -m "not slow"
 
 # The tests of minutes (pytest -m slow): the quarter crown against the whole run's quadrants,
 # the 3D cases of the predictor list (the 2D ones, in make test, take the same paths).

@@ -31,13 +31,27 @@ _one_at_a_time = threading.Lock()   # one Taichi runtime a process: a worker sta
 #                                     several threads still runs its points in turn
 
 
+# CPython 3.11's ast module keeps its recursion depth per interpreter, not per thread
+# (python/cpython gh-106905): Taichi parsing a kernel in the worker's task thread while another
+# thread of the worker builds an AST can end in this SystemError. It is the interpreter's
+# bookkeeping, not the point's: seen once in a full suite (tests/test_sweep_dask.py, U = 5
+# failed while its neighbour worker was being killed).
+AST_DEPTH_ERROR = "AST constructor recursion depth mismatch"
+
+
 def run_point(resolved, spec: BackendSpec) -> dict:
-    """One point through this worker's simulator (``sweep.measure_point``), as a dict."""
+    """One point through this worker's simulator (``sweep.measure_point``), as a dict; run
+    once more if the first try hits CPython's AST depth error (AST_DEPTH_ERROR)."""
     with _one_at_a_time:
         backend.init(spec.arch, spec.precision, spec.seed, threads=spec.threads,
                      fast_compile=spec.fast_compile)
         if _worker.get("spec") != spec:         # a new backend: the old simulators are gone
             _worker.update(spec=spec, session=Session())
+        try:
+            return sweep.measure_point(resolved, _worker["session"]).as_dict()
+        except SystemError as e:
+            if AST_DEPTH_ERROR not in str(e):
+                raise
         return sweep.measure_point(resolved, _worker["session"]).as_dict()
 
 
