@@ -23,7 +23,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Dict, Iterable, Optional, Tuple
 
-from ..core.params import COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, WALL_MODELS, WATER
+from ..core.params import (COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, SURFACE_TENSION_MODELS,
+                           WALL_MODELS, WATER)
 from ..core.symmetry import SYMMETRIES
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
@@ -156,6 +157,9 @@ NUMERICS_KEYS = {
     "fixed_dt": number("a fixed time step instead of the adaptive one", "s", 1.0e-8, 1.0,
                        lo_incl=True),
     "pressure_gradient": Field("choice", "pressure-gradient form (M2)", choices=GRADIENT_FORMS),
+    "surface_tension": Field("choice", "surface-tension model (core/surface_tension/): the "
+                             "seed's inter-particle potential (S22-S24) or P = sigma kappa on "
+                             "the free surface (curvature)", choices=SURFACE_TENSION_MODELS),
     "beta": number("free-surface threshold n < beta n0 (M3); with P clamped at 0 (n < n0 has "
                    "P = 0 anyway) it changes no pressure", "", 0.5, 1.0, lo_incl=True,
                    hi_incl=False),

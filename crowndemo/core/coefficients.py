@@ -16,6 +16,7 @@ class Coefficients:
         self.l0, self.re, self.re2, self.n0, self.lambda0 = s(), s(), s(), s(), s()
         self.rho, self.nu, self.c2, self.mass = s(), s(), s(), s()
         self.st_over_m = s()          # C / m of the potential model (S24)
+        self.sigma = s()              # surface tension (the curvature model's P = sigma kappa)
         self.beta = s()               # free-surface threshold (M3)
         self.col_r2 = s()             # (collision distance)^2 of the collision model
         self.col_e = s()              # its restitution coefficient
@@ -35,6 +36,7 @@ class Coefficients:
         self.c2[None] = physics.c ** 2
         self.mass[None] = lattice.mass
         self.st_over_m[None] = lattice.C / lattice.mass
+        self.sigma[None] = physics.sigma
         self.beta[None] = numerics.free_surface_beta(physics.dim)
         self.col_r2[None] = (numerics.collision * physics.l0) ** 2
         self.col_e[None] = numerics.restitution

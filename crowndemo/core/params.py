@@ -12,6 +12,9 @@ from typing import Any, Optional, Tuple, TypeVar
 GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
 COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; terms.py)
+# the surface-tension family (core/surface_tension/): the seed's potential (S22-S24) or the
+# curvature-based pressure boundary condition P = sigma kappa (Tsujimura et al. 2023)
+SURFACE_TENSION_MODELS = ("potential", "curvature")
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
@@ -80,6 +83,7 @@ class Numerics:
     fixed_dt: Optional[float] = None
     allow_unsafe_dt: bool = False   # only for tests that force an unstable run
     pressure_gradient: str = "pmin"
+    surface_tension: str = "potential"   # SURFACE_TENSION_MODELS; compiled in when sigma > 0
     beta: Optional[float] = None    # free-surface threshold n < beta n0 (M3); None: 0.97/0.98
     max_density_excess: float = 0.5  # abort when n/n0 - 1 exceeds this
     max_mach: float = 1.0           # abort when a speed exceeds max_mach * c
@@ -120,6 +124,8 @@ class Numerics:
              "fixed_dt", "> 0 s, or unset for adaptive")
         need(self.pressure_gradient in GRADIENT_FORMS, "pressure_gradient",
              " | ".join(GRADIENT_FORMS))
+        need(self.surface_tension in SURFACE_TENSION_MODELS, "surface_tension",
+             " | ".join(SURFACE_TENSION_MODELS))
         need(self.beta is None or 0.5 <= self.beta < 1.0, "beta", "0.5 <= beta < 1")
         need(self.max_density_excess > 0, "max_density_excess", "> 0")
         need(self.max_mach > 0, "max_mach", "> 0")
@@ -159,6 +165,7 @@ class Model:
     relative_courant: bool = False   # the relative speed measured (terms.py)
     mirror_planes: Tuple[int, ...] = ()   # symmetry planes (symmetry.py)
     predictor_list: bool = False     # the predictor's pairs from the last list (terms.py)
+    surface_tension_model: str = "potential"   # the family member (core/surface_tension/)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
@@ -166,7 +173,8 @@ class Model:
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
                    numerics.cells_per_re, numerics.wall_model == "plane",
                    numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
-                   numerics.predictor_list and numerics.neighbour_list)
+                   numerics.predictor_list and numerics.neighbour_list,
+                   numerics.surface_tension)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
@@ -175,7 +183,8 @@ class Model:
                 "cells_per_re": self.cells_per_re, "plane_floor": self.plane_floor,
                 "relative_courant": self.relative_courant,
                 "mirror_planes": list(self.mirror_planes),
-                "predictor_list": self.predictor_list}
+                "predictor_list": self.predictor_list,
+                "surface_tension_model": self.surface_tension_model}
 
 
 def _finite(x) -> bool:
@@ -195,4 +204,4 @@ def with_values(obj: _Params, **changes: Any) -> _Params:
 
 
 __all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "WALL_MODELS",
-           "COURANT_SPEEDS", "with_values"]
+           "COURANT_SPEEDS", "SURFACE_TENSION_MODELS", "with_values"]

@@ -6,7 +6,7 @@ and the pressure-gradient corrector (S18-S20) in one of three forms (M2):
 - ``sum``:  (P_j + P_i), the momentum-conserving form of explicit MPS papers.
 """
 
-from typing import Optional
+from typing import Any, Optional
 
 import taichi as ti
 
@@ -42,9 +42,12 @@ def _density_sums():
 @ti.data_oriented
 class Pressure:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients,
-                 floor: Optional[PlaneFloor] = None):
+                 floor: Optional[PlaneFloor] = None, surface: Optional[Any] = None):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
         self.floor = floor          # the analytic plane floor when the model has one
+        # the surface-tension member, whose boundary_pressure follows S17 (a no-op for the
+        # potential, P = sigma kappa on the surface for the curvature model)
+        self.surface = surface
         self.dim = model.dim
         self.sums = _gradient_sums(self.dim)
         self.density_sums = _density_sums()
@@ -72,8 +75,14 @@ class Pressure:
     def _floor_density(self, z) -> float:
         return self.floor.at(z)[FLOOR_N]
 
+    def density_and_pressure(self) -> None:
+        """n (S9) and P (S17, M3), then the surface-tension member's boundary pressure."""
+        self._density_and_pressure()
+        if self.surface is not None:
+            self.surface.boundary_pressure()
+
     @ti.kernel
-    def density_and_pressure(self):
+    def _density_and_pressure(self):
         """n (S9) and P (S17) for fluid and wall particles; dummies only count in n. With the
         neighbour list, each fluid particle's neighbours are listed on the way (dummies only
         for the predictor's pairs from the list)."""

@@ -12,7 +12,7 @@ from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
-from . import timestep
+from . import surface_tension, timestep
 from .coefficients import Coefficients
 from .grid import CellGrid
 from .health import Health, HealthReport, InstabilityError, count_kinds
@@ -169,9 +169,12 @@ class Simulator:
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.floor = PlaneFloor() if self.model.plane_floor else None   # else not allocated
-        self.pressure = Pressure(self.model, self.grid, self.coef, self.floor)
+        # the surface-tension member chosen by name (core/surface_tension/); None at sigma = 0
+        self.surface_tension = surface_tension.create(self.model, self.grid, self.coef)
+        self.pressure = Pressure(self.model, self.grid, self.coef, self.floor,
+                                 self.surface_tension)
         self.predictor = Predictor(self.model, self.grid, self.coef, self.floor,
-                                   self.pressure.neighbours)
+                                   self.pressure.neighbours, self.surface_tension)
         # the density pass's lists hold the pairs at the positions the corrector moved from
         # (terms.py, the predictor's pairs from the list): False until a step has listed them
         self._lists_ready = False
@@ -424,5 +427,6 @@ class Simulator:
     def memory_bytes(self) -> int:
         return (self.state.nbytes_per_particle() * self.state.capacity + self.grid.nbytes()
                 + self.predictor.nbytes() + self.pressure.nbytes()
+                + (self.surface_tension.nbytes() if self.surface_tension else 0)
                 + (self.floor.nbytes() if self.floor else 0)
                 + (self.symmetry.nbytes() if self.symmetry else 0))

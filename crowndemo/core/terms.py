@@ -41,7 +41,7 @@ codes (Koshizuka, Nobe & Oka 1998; Lee et al. 2011, CMAME 200: 1113) removes the
 velocity of pairs closer than ``collision * l0`` before they collapse.
 """
 
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
 import taichi as ti
 
@@ -59,20 +59,16 @@ CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per partic
 #                     lattice has none; a splash a few)
 
 
-@ti.func
-def surface_tension_pair(rij, r, l0, re):
-    """Minus the gradient of the inter-particle potential (S22) for one pair, per unit C:
-    (r - l0)(r - re) r_ij / r with r_ij = r_j - r_i (method.md §4 sign note).
-    Times C/m (C <= 0) it attracts for l0 < r < re and repels for r < l0."""
-    return (r - l0) * (r - re) / r * rij
-
-
 @ti.data_oriented
 class Predictor:
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients,
                  floor: Optional[PlaneFloor] = None,
-                 neighbours: Optional[NeighbourList] = None):
+                 neighbours: Optional[NeighbourList] = None, surface: Optional[Any] = None):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
+        # the surface-tension member (core/surface_tension/); its pair term is summed in the
+        # walk only when it has one (the curvature model acts through the pressure)
+        self.surface = surface
+        self.st_pairs = bool(model.surface_tension and surface is not None and surface.pair_term)
         # the density pass's list, for the pairs of ``forces(from_list=1)`` (module docstring)
         self.neighbours = neighbours if model.predictor_list and self._walks else None
         self.floor = floor          # the analytic plane floor when the model has one
@@ -124,8 +120,7 @@ class Predictor:
     def _walks(self) -> bool:
         """``forces`` walks the neighbours: for viscosity, surface tension or the relative
         speed (the collision pass walks on its own where nothing else does)."""
-        return (self.model.viscosity or self.model.surface_tension
-                or self.model.relative_courant)
+        return self.model.viscosity or self.st_pairs or self.model.relative_courant
 
     @ti.func
     def _collision_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -146,7 +141,8 @@ class Predictor:
     @ti.func
     def _pair(self, i, j, rij, r2, acc: ti.template()):
         """Sums, without their constant factors: sum (u_j - u_i) w (S12; walls have u = 0,
-        no-slip) and sum (r - l0)(r - re) r_ij / r over fluid j (S24)."""
+        no-slip) and the surface-tension member's pair term over fluid j (the potential's
+        (r - l0)(r - re) r_ij / r, S24)."""
         if ti.static(self.lists_close_pairs):
             if r2 < self.coef.col_r2[None]:      # every kind, as the collision walk
                 if acc.close < CLOSE_SLOTS:
@@ -160,10 +156,9 @@ class Predictor:
                 acc.rel2 = ti.max(acc.rel2, du.dot(du))
             if ti.static(self.model.viscosity):
                 acc.visc += laplacian_pair(du, weight(r, self.coef.re[None]))
-            if ti.static(self.model.surface_tension):
-                if kind_j == FLUID:      # fluid-fluid potential (sign per method.md §4)
-                    acc.st += surface_tension_pair(rij, r, self.coef.l0[None],
-                                                   self.coef.re[None])
+            if ti.static(self.st_pairs):
+                if kind_j == FLUID:      # fluid-fluid (the potential's sign per method.md §4)
+                    acc.st += self.surface.pair(rij, r)
 
     def run(self, dt: float, mark: Callable[[str], None] = lambda stage: None,
             sync: Optional[Callable[[], None]] = None, from_list: bool = False) -> None:
@@ -248,8 +243,8 @@ class Predictor:
                     a = ti.Vector.zero(float, self.dim)
                     if ti.static(self.model.viscosity):
                         a += visc * acc.visc
-                    if ti.static(self.model.surface_tension):
-                        a += self.coef.st_over_m[None] * acc.st
+                    if ti.static(self.st_pairs):
+                        a += self.surface.finish(acc.st)
                     if ti.static(self.model.gravity):
                         a += self.coef.gravity[None]
                     self.state.scratch_vec[i] = a

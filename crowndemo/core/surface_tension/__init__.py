@@ -1,0 +1,39 @@
+"""Surface tension as a family (docs/architecture.md): one module per model behind one small
+interface, chosen by name with ``numerics.surface_tension`` and compiled in only when
+sigma > 0 (``Model.surface_tension``).
+
+A member is a ``ti.data_oriented`` object with
+
+- ``pair_term``: True if it adds a pair term to the predictor's walk (method.md §3 step 1);
+  then ``pair(rij, r)`` (a ``ti.func``, the term of one fluid-fluid pair j of i, r_ij = r_j -
+  r_i) and ``finish(acc)`` (a ``ti.func``, the acceleration from the summed terms) are called
+  by the predictor under ``ti.static``;
+- ``boundary_pressure()``: called right after the number density and pressure at r* (S17, M3),
+  before the corrector; a member that acts through the pressure sets it there (a no-op else);
+- ``nbytes()``: the memory of its own fields.
+
+Members: ``potential`` (the seed's inter-particle potential, S22-S24, Kondo et al. 2007) and
+``curvature`` (the Young-Laplace pressure sigma kappa on free-surface particles, Tsujimura,
+Kubota & Sato 2023, with kappa from a least-squares fit of the surface; curvature.py).
+"""
+from typing import Dict, Optional, Type
+
+from ..coefficients import Coefficients
+from ..grid import CellGrid
+from ..params import SURFACE_TENSION_MODELS, Model
+from .curvature import CurvatureTension
+from .potential import PotentialTension
+
+MODELS: Dict[str, Type] = {"potential": PotentialTension, "curvature": CurvatureTension}
+assert tuple(MODELS) == SURFACE_TENSION_MODELS     # the names params.py validates against
+
+
+def create(model: Model, grid: CellGrid, coef: Coefficients) -> Optional[object]:
+    """The member ``model.surface_tension_model`` for this model, or None without surface
+    tension (sigma = 0: nothing compiled in)."""
+    if not model.surface_tension:
+        return None
+    return MODELS[model.surface_tension_model](model, grid, coef)
+
+
+__all__ = ["MODELS", "create", "PotentialTension", "CurvatureTension"]
