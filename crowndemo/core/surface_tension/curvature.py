@@ -6,7 +6,7 @@ the free surface (Tsujimura, Kubota & Sato, Comput. Part. Mech. 10, 2023),
 so the liquid inside a resting drop settles at sigma kappa (sigma/R in 2D, 2 sigma/R in 3D)
 through the ordinary pressure gradient (S18), with no delta function to normalise.
 
-kappa_i, two neighbour passes at r* after the number density (S17), docs/surface_tension.md:
+kappa_i, two neighbour passes at r* after the number density (S17):
 1. the unit normal n_i = -grad n / |grad n|, grad n_i = sum_j w'(r) (r_i - r_j)/r
    = re sum_j r_ij / r^3 over every neighbour (S9 counts every kind), for free-surface i;
 2. a weighted least-squares fit, in i's frame (tangents t, normal n_i), of the height
@@ -21,6 +21,9 @@ kappa_i, two neighbour passes at r* after the number density (S17), docs/surface
 The fit measured better than the divergence of the normal (renormalised as in Adami, Hu &
 Adams 2010, or by a least-squares gradient): on particles placed on a circle or sphere the
 divergence scattered by 40-180 % per particle at R/l0 = 8-16, the fit by under 2 %.
+
+Experimental: the curvature is tested (tests/test_curvature.py), but the model does not yet
+hold a free drop; docs/surface_tension_curvature.md has the measurements and what is left.
 
 Dimension-generic: the monomials and the frame are chosen with ti.static (3 unknowns in 2D,
 6 in 3D). |kappa| is capped at (d-1)/l0, a drop of radius l0.
