@@ -32,9 +32,9 @@ import taichi as ti
 
 from ..coefficients import Coefficients
 from ..grid import CellGrid
+from ..operators import weight
 from ..params import Model
-from ..state import FLUID, WALL
-from ..state import field_nbytes
+from ..state import FLUID, WALL, field_nbytes
 
 LAYER = 0.5      # the surface layer: |h| < LAYER l0 about i's tangent plane
 OFFSET = 0.5     # the liquid's surface lies OFFSET l0 outside the outer particles' centres
@@ -179,7 +179,7 @@ class CurvatureTension:
                 acc.out += 1                          # i lies under the surface layer
             elif h > -LAYER and kind_j == FLUID:
                 phi = monomials(x)
-                w = self.coef.re[None] / ti.sqrt(r2) - 1.0      # (S10)
+                w = weight(ti.sqrt(r2), self.coef.re[None])      # (S10)
                 acc.m += w * phi.outer_product(phi)
                 acc.b += w * h * phi
                 acc.count += 1
@@ -189,7 +189,7 @@ class CurvatureTension:
         """Pass 2: kappa from the surface fit (module docstring); P = sigma kappa where i is in
         the outer layer and the fit is regular."""
         k = ti.static(3 if self.dim == 2 else 6)
-        w_self = self.coef.re[None] / self.coef.l0[None] - 1.0      # w(l0), i itself at t = 0
+        w_self = weight(self.coef.l0[None], self.coef.re[None])    # w(l0), i itself at t = 0
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
