@@ -27,7 +27,7 @@ from typing import Dict, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .surface import SurfaceMesh, mirror, plane_axes
+from .surface import SurfaceMesh, mirror, plane_axes, used_vertices
 
 CELL = 4.0      # column side / l0
 NEAR = 3.0      # particles below the film's thickness h + NEAR l0 are the film's
@@ -141,9 +141,7 @@ def join(mesh: SurfaceMesh, cols: FilmColumns) -> SurfaceMesh:
     low = mesh.vertices[:, 2] < cols.top_layer + 2.0 * cols.l0
     gone = (over_cut & low)[mesh.triangles].all(axis=1)
     tris = mesh.triangles[~gone]
-    used = np.unique(tris)
-    index = np.full(mesh.n_vertices, -1, np.int64)
-    index[used] = np.arange(len(used))
+    used, index = used_vertices(tris, mesh.n_vertices)
     kept = SurfaceMesh(mesh.vertices[used], index[tris], mesh.normals[used],
                        {k: v[used] for k, v in mesh.fields.items()})
     # the film top where the mesh keeps flat film: its upward-facing vertices there
