@@ -209,6 +209,7 @@ def _reconstruct_grid(p: np.ndarray, l0: float, values: Dict[str, np.ndarray],
     tri_mesh = rec.mesh
     fields = {}
     if values:
+        # the particle mass scales numerator and unity alike: any positive value will do
         sph = pysplashsurf.SphInterpolator(p, np.asarray(rec.particle_densities),
                                            1000.0 * l0 ** 3, params.support(l0))
         at = np.asarray(tri_mesh.vertices)
