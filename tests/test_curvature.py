@@ -126,7 +126,7 @@ def test_flat_surface(sim, R):
 def test_family_names_and_default():
     """The registry and the validated names agree; the seed's potential is the default, and
     at sigma = 0 no member is compiled in."""
-    assert tuple(MODELS) == SURFACE_TENSION_MODELS == ("potential", "curvature")
+    assert tuple(MODELS) == SURFACE_TENSION_MODELS == ("potential", "stress", "curvature")
     assert MODELS["potential"] is PotentialTension
     assert Numerics().surface_tension == "potential"
     assert Model.of(physics(2), Numerics()).surface_tension_model == "potential"
@@ -138,4 +138,4 @@ def test_unknown_model_refused():
     with pytest.raises(ParameterError) as err:
         Numerics(surface_tension="bogus").validate()
     msg = str(err.value)
-    assert "surface_tension" in msg and "'bogus'" in msg and "potential | curvature" in msg
+    assert "surface_tension" in msg and "'bogus'" in msg and "potential | stress | curvature" in msg

@@ -11,6 +11,25 @@ from ..core.params import SOUND_SPEED_FACTOR
 from .common import load_preset
 
 
+SURFACE_TENSION_WHAT = {
+    "potential": "the seed's inter-particle potential (S22-S24, Kondo et al. 2007)",
+    "stress": "the continuum surface stress, div of sigma (|g| I - g g^T/|g|) (method.md §4c)",
+    "curvature": "P = sigma kappa on the free surface (method.md §4b; experimental)",
+}
+
+
+def surface_tension_summary(model: str, lat, sigma: float) -> dict:
+    """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3)."""
+    if model == "potential":
+        constants = {"C": lat.C}
+    elif model == "stress":
+        constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd}
+    else:
+        constants = {}
+    return {"model": model, "what": SURFACE_TENSION_WHAT[model], "sigma_N_m": sigma,
+            "constants": constants}
+
+
 def _preset_facts(r, tp) -> Dict:
     """Every resolved value and derived quantity of a preset at one quality (no kernels)."""
     from dataclasses import asdict
@@ -50,6 +69,7 @@ def _preset_facts(r, tp) -> Dict:
         "film_over_l0": h / ph.l0, "n0": lat.n0, "lambda0": lat.lambda0,
         "lambda0_over_l0_sq": lat.lambda0 / lat.l0 ** 2, "C": lat.C, "mass": lat.mass,
         "mass_unit": "kg" if ph.dim == 3 else "kg/m (per unit depth)",
+        "surface_tension": surface_tension_summary(r.numerics.surface_tension, lat, ph.sigma),
         "sound_speed_m_s": ph.c,
         "sound_speed_source": s.get("sound_speed_source") or (
             "given" if s.get("sound_speed") is not None else f"{SOUND_SPEED_FACTOR:g} x speed"),
@@ -143,6 +163,10 @@ def info_preset(args) -> int:
     print(f"  constants   n0 {f['n0']:.6g}, lambda0 {f['lambda0']:.6g} m^2 (= "
           f"{f['lambda0_over_l0_sq']:.6g} l0^2), C {f['C']:.6g} {c_unit}, mass {f['mass']:.6g} "
           f"{f['mass_unit']}")
+    st = f["surface_tension"]
+    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2"}
+    print(f"  tension     {st['model']}: {st['what']}" + "".join(
+        f"; {k.split('_1_')[0]} {v:.6g}{units.get(k, '')}" for k, v in st["constants"].items()))
     print(f"  sound speed c = {f['sound_speed_m_s']:.4g} m/s ({f['sound_speed_source']})")
     n = f["numerics"]
     beta = n["beta"] if n["beta"] is not None else r.numerics.free_surface_beta(r.dim)

@@ -158,8 +158,9 @@ NUMERICS_KEYS = {
                        lo_incl=True),
     "pressure_gradient": Field("choice", "pressure-gradient form (M2)", choices=GRADIENT_FORMS),
     "surface_tension": Field("choice", "surface-tension model (core/surface_tension/): the "
-                             "seed's inter-particle potential (S22-S24), or P = sigma kappa on "
-                             "the free surface (curvature; experimental, "
+                             "seed's inter-particle potential (S22-S24), the continuum surface "
+                             "stress (stress, method.md §4c; with pressure_gradient: sum), or "
+                             "P = sigma kappa on the free surface (curvature; experimental, "
                              "docs/surface_tension_curvature.md)", choices=SURFACE_TENSION_MODELS),
     "beta": number("free-surface threshold n < beta n0 (M3); with P clamped at 0 (n < n0 has "
                    "P = 0 anyway) it changes no pressure", "", 0.5, 1.0, lo_incl=True,

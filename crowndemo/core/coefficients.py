@@ -17,6 +17,9 @@ class Coefficients:
         self.rho, self.nu, self.c2, self.mass = s(), s(), s(), s()
         self.st_over_m = s()          # C / m of the potential model (S24)
         self.sigma = s()              # surface tension (the curvature model's P = sigma kappa)
+        self.stress_a = s()           # the surface-stress model's lattice normaliser a (C2)
+        self.stress_K = s()           # its colour gradient's normalisation K (C1)
+        self.stress_Kd = s()          # its divergence's normalisation K_d (C3)
         self.beta = s()               # free-surface threshold (M3)
         self.col_r2 = s()             # (collision distance)^2 of the collision model
         self.col_e = s()              # its restitution coefficient
@@ -37,6 +40,9 @@ class Coefficients:
         self.mass[None] = lattice.mass
         self.st_over_m[None] = lattice.C / lattice.mass
         self.sigma[None] = physics.sigma
+        self.stress_a[None] = lattice.stress_a
+        self.stress_K[None] = lattice.stress_K
+        self.stress_Kd[None] = lattice.stress_Kd
         self.beta[None] = numerics.free_surface_beta(physics.dim)
         self.col_r2[None] = (numerics.collision * physics.l0) ** 2
         self.col_e[None] = numerics.restitution

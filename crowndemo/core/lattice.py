@@ -77,6 +77,66 @@ def surface_tension_coefficient(dim: int, l0: float, re: float, sigma: float) ->
     return -2.0 * sigma * l0 ** (dim - 1) / cut_potential_sum(dim, l0, re)
 
 
+def stress_kernel(r: np.ndarray, re: float) -> np.ndarray:
+    """f(r) = (1 - r/re)^3 for r < re, else 0: the surface-stress model's pair weight (method.md
+    §4c, C1): r_ij f(r) is a Wendland C2 kernel's gradient, bounded where w/r^2 is not."""
+    r = np.asarray(r, dtype=float)
+    return np.where(r < re, (1.0 - np.minimum(r, re) / re) ** 3, 0.0)
+
+
+def stress_pair_kernel(r: np.ndarray, re: float) -> np.ndarray:
+    """f_d(r) = 1 - (r/re)^4 for r < re, else 0: the divergence's pair weight (C3). The pair
+    force r f_d(r) grows with r up to re / 5^(1/4) = 1.4 l0 (re = 2.1 l0), so a tension along
+    the surface pulls two particles less as they close (no clumping at the lattice spacing).
+    The step's kernel also has a repulsive core below l0 (surface_tension/stress.py), where no
+    lattice pair lies: the lattice sums here do not see it."""
+    r = np.asarray(r, dtype=float)
+    return np.where(r < re, 1.0 - (np.minimum(r, re) / re) ** 4, 0.0)
+
+
+def stress_gradient_norm(dim: int, l0: float, re: float, kernel=stress_kernel) -> float:
+    """K = d / sum_j r^2 f(r) on the lattice: the normalisation that makes the pair sum
+    K sum_j (phi_j - phi_i) r_ij f(r_ij) the exact gradient of a linear phi (C1, C3)."""
+    r = np.linalg.norm(lattice_offsets(dim, l0, re), axis=1)
+    return dim / float((r ** 2 * kernel(r, re)).sum())
+
+
+def colour_gradient_column(dim: int, l0: float, re: float) -> np.ndarray:
+    """|g_k| for the layers k = 0, 1, ... of a lattice half-space z <= 0 (layer k at z = -k l0,
+    down to the first one deeper than re, where g = 0): g_i = K sum_j r_ij f(r_ij) over the
+    lattice points j within re of i (method.md §4c, C1), here along the last axis."""
+    offs = lattice_offsets(dim, l0, re)
+    f = stress_kernel(np.linalg.norm(offs, axis=1), re)
+    K = stress_gradient_norm(dim, l0, re)
+    m = int(math.ceil(re / l0))
+    out = np.zeros(m + 1)
+    for k in range(m + 1):
+        present = -k * l0 + offs[:, -1] <= 0.5 * l0 * 1e-6       # j in the half-space
+        out[k] = abs(K * float((offs[present, -1] * f[present]).sum()))
+    return out
+
+
+def stress_normaliser(dim: int, l0: float, re: float) -> float:
+    """a of the surface-stress model (method.md §4c, C2): the factor that makes the flat
+    lattice surface carry sigma. Across a cut normal to x through the half-space, the sum form
+    of the divergence (C3) transmits, per unit length of the surface (and depth in 2D),
+    a sigma l0 K sum_k sum_{r_x > 0} r_x^2 f(r) (|g_k| + |g_k'|) (j = i + r in layer k');
+    a makes that sigma. Dimensionless."""
+    offs = lattice_offsets(dim, l0, re)
+    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), re)
+    K = stress_gradient_norm(dim, l0, re, stress_pair_kernel)
+    g = colour_gradient_column(dim, l0, re)
+    m = len(g) - 1
+    total = 0.0
+    for k in range(m + 1):
+        for off, ff in zip(offs, f):
+            kj = k - int(round(off[-1] / l0))           # j's layer (z_j = -kj l0)
+            if off[0] > 0 and kj >= 0:
+                gj = g[kj] if kj <= m else 0.0
+                total += off[0] ** 2 * ff * (g[k] + gj)
+    return 1.0 / (l0 * K * total)
+
+
 @dataclass(frozen=True)
 class LatticeConstants:
     dim: int
@@ -86,6 +146,9 @@ class LatticeConstants:
     lambda0: float
     C: float
     mass: float   # rho l0^d (per unit depth in 2D)
+    stress_a: float = 0.0   # the surface-stress model's normaliser a (C2)
+    stress_K: float = 0.0   # the colour gradient's normalisation K (C1) [1/m^2]
+    stress_Kd: float = 0.0  # the divergence's normalisation K_d (C3) [1/m^2]
 
     @classmethod
     def compute(cls, dim: int, l0: float, re_ratio: float, rho: float, sigma: float
@@ -97,7 +160,9 @@ class LatticeConstants:
         re = re_ratio * l0
         n0, lam = n0_lambda0(dim, l0, re)
         return cls(dim, l0, re, n0, lam, surface_tension_coefficient(dim, l0, re, sigma),
-                   rho * l0 ** dim)
+                   rho * l0 ** dim, stress_normaliser(dim, l0, re),
+                   stress_gradient_norm(dim, l0, re),
+                   stress_gradient_norm(dim, l0, re, stress_pair_kernel))
 
 
 def lattice_cohesion_pressure(dim: int, l0: float, re: float, C: float) -> float:

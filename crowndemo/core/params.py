@@ -13,8 +13,9 @@ GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i;
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
 COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; terms.py)
 # the surface-tension family (core/surface_tension/): the seed's potential (S22-S24) or the
-# curvature-based pressure boundary condition P = sigma kappa (Tsujimura et al. 2023)
-SURFACE_TENSION_MODELS = ("potential", "curvature")
+# continuum surface stress (method.md §4c) or the curvature-based pressure boundary condition
+# P = sigma kappa (Tsujimura et al. 2023; experimental)
+SURFACE_TENSION_MODELS = ("potential", "stress", "curvature")
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m

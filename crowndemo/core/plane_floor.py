@@ -8,7 +8,7 @@ lattice continued below the surface, wall particles at s = -l0/2 and ``layers - 
 layers under them. The tables are summed for a particle right above a column of that lattice,
 so a fluid lattice at rest sees exactly the number density it would see with the particles;
 a particle between columns sees the same values (the particle floor's lateral ripple is left
-out). Per height s, three sums over the layers' points j within re:
+out). Per height s, four sums over the layers' points j within re:
 
 - n_floor(s) = sum over every layer of w(r)                 -> number density (S9)
 - g_floor(s) = sum over the wall layer of (z_j - z_i) w / r^2 -> pressure gradient (S11), the
@@ -16,6 +16,8 @@ out). Per height s, three sums over the layers' points j within re:
   (P_i without gravity): with P_j = P_i the floor pushed too little and the 2D tank's floor
   pressure read 6.6 % low
 - v_floor(s) = sum over the wall layer of w(r)              -> viscosity (S12), u_j = 0
+- c_floor(s) = sum over every layer of (z_j - z_i) f(r)     -> the surface-stress model's
+  colour gradient (method.md C1): the floor is no free surface
 
 and a particle closer than the collision distance to the wall layer's plane loses its
 approach speed as against a wall particle (the collision model, terms.py).
@@ -28,24 +30,25 @@ from typing import Tuple
 import numpy as np
 import taichi as ti
 
-from .lattice import weight
+from .lattice import stress_kernel, weight
 
 SAMPLES = 1024
-FLOOR_N, FLOOR_G, FLOOR_V = 0, 1, 2
+FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C = 0, 1, 2, 3
 
 
 def floor_tables(dim: int, l0: float, re: float, layers: int,
                  samples: int = SAMPLES) -> Tuple[float, float, np.ndarray]:
-    """(s0, ds, table[samples, 3]): n_floor, g_floor (the component along the last axis) and
-    v_floor at s = s0 + k ds, from s0 = -l0/4 (closer, the collision model has acted; the
-    table holds its last value) to re - l0/2 (beyond, no floor point is within re)."""
+    """(s0, ds, table[samples, 4]): n_floor, g_floor (the component along the last axis),
+    v_floor and c_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
+    collision model has acted; the table holds its last value) to re - l0/2 (beyond, no floor
+    point is within re)."""
     s0, s1 = -0.25 * l0, re - 0.5 * l0
     ds = (s1 - s0) / (samples - 1)
     m = int(math.ceil(re / l0))
     lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
     lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
     lat2 = (lateral ** 2).sum(axis=1)
-    table = np.zeros((samples, 3))
+    table = np.zeros((samples, 4))
     for k in range(samples):
         s = s0 + k * ds
         for layer in range(layers):
@@ -53,6 +56,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
             r = np.sqrt(lat2 + dz * dz)
             w = weight(r, re)
             table[k, FLOOR_N] += w.sum()
+            table[k, FLOOR_C] += (dz * stress_kernel(r, re)).sum()
             if layer == 0:
                 table[k, FLOOR_G] += (dz / (r * r) * w).sum()
                 table[k, FLOOR_V] += w.sum()
@@ -62,7 +66,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
 @ti.data_oriented
 class PlaneFloor:
     def __init__(self):
-        self.table = ti.Vector.field(3, float, SAMPLES)
+        self.table = ti.Vector.field(4, float, SAMPLES)
         self.s0 = ti.field(float, shape=())
         self.inv_ds = ti.field(float, shape=())
         self.wall_depth = ti.field(float, shape=())    # the wall layer's plane: s = -l0/2
@@ -81,7 +85,8 @@ class PlaneFloor:
 
     @ti.func
     def at(self, s):
-        """(n_floor, g_floor, v_floor) at height s, linear between samples; zero past the top."""
+        """(n_floor, g_floor, v_floor, c_floor) at height s, linear between samples; zero past
+        the top."""
         # clamped before the cast: a height far up (or inf, NaN) would cast to INT_MIN
         x = ti.min((ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None],
                    float(SAMPLES - 1))
@@ -90,5 +95,10 @@ class PlaneFloor:
         upper = ti.min(row + 1, SAMPLES - 1)      # the last sample is zero: zero past it
         return (1.0 - frac) * self.table[row] + frac * self.table[upper]
 
+    @ti.func
+    def colour_at(self, s):
+        """c_floor at height s (the module docstring's fourth sum)."""
+        return self.at(s)[FLOOR_C]
 
-__all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V"]
+
+__all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V", "FLOOR_C"]

@@ -58,6 +58,11 @@ class Pressure:
     def nbytes(self) -> int:
         return self.neighbours.nbytes() if self.neighbours is not None else 0
 
+    @property
+    def _surface_in_corrector(self) -> bool:
+        """The surface-tension member adds an acceleration at r* to the corrector's."""
+        return self.surface is not None and getattr(self.surface, "corrector_term", False)
+
     @ti.func
     def _density_listing_pair(self, i, j, rij, r2, acc: ti.template()):
         """The number density's term (S9), and j in i's list unless it is a dummy (the
@@ -136,7 +141,8 @@ class Pressure:
 
     @ti.kernel
     def correct(self, dt: float):
-        """a' = -(1/rho) <grad P> (S18); u += dt a' (S19); r += dt^2 a' (S20).
+        """a' = -(1/rho) <grad P> (S18), plus the surface stress's divergence (C3) with that
+        member; u += dt a' (S19); r += dt^2 a' (S20).
         P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum).
         The neighbours come from the list of ``density_and_pressure`` (same positions) where
         it holds them all, else from the cell walk."""
@@ -180,7 +186,10 @@ class Pressure:
                 elif ti.static(self.model.pressure_gradient == "sum"):
                     p_ref = -p_i
                 grad = self.dim / self.coef.n0[None] * (acc.pg - p_ref * acc.g)
-                self.state.scratch_vec[i] = -grad / self.coef.rho[None]
+                a = -grad / self.coef.rho[None]
+                if ti.static(self._surface_in_corrector):
+                    a += self.surface.acceleration(i)      # the surface stress (C3) at r*
+                self.state.scratch_vec[i] = a
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             if self.state.kind[i] == FLUID:

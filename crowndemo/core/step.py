@@ -169,8 +169,12 @@ class Simulator:
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.floor = PlaneFloor() if self.model.plane_floor else None   # else not allocated
+        # mirror images across the symmetry planes (symmetry.py); None for a whole scene
+        self.symmetry = (Symmetry(self.state, self.model.mirror_planes)
+                         if self.model.mirror_planes else None)
         # the surface-tension member chosen by name (core/surface_tension/); None at sigma = 0
-        self.surface_tension = surface_tension.create(self.model, self.grid, self.coef)
+        self.surface_tension = surface_tension.create(self.model, self.grid, self.coef,
+                                                      self.floor, self.symmetry)
         self.pressure = Pressure(self.model, self.grid, self.coef, self.floor,
                                  self.surface_tension)
         self.predictor = Predictor(self.model, self.grid, self.coef, self.floor,
@@ -179,9 +183,6 @@ class Simulator:
         # (terms.py, the predictor's pairs from the list): False until a step has listed them
         self._lists_ready = False
         self.health = Health(self.state, self.coef)
-        # mirror images across the symmetry planes (symmetry.py); None for a whole scene
-        self.symmetry = (Symmetry(self.state, self.model.mirror_planes)
-                         if self.model.mirror_planes else None)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
         self.stats = RunStats()
         self.n_fluid = 0

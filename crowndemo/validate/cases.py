@@ -56,6 +56,9 @@ class Case:
                                  "plane-floor")
     quick_variant: Optional[str] = ""   # the one variant `--quick` runs ("": the first; None:
                                         # none, another case's quick row runs it)
+    # the case's own base settings, before a variant's change (the surface-stress drops:
+    # that model and the sum form, tension_cases.py)
+    base: Callable[[Numerics], Numerics] = lambda numerics: numerics
 
     @property
     def quick_variants(self) -> Tuple[str, ...]:
@@ -349,7 +352,12 @@ QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "laplace-2d": None, "laplace-3d": "safety/2",
                  "shear-wave-2d": "f64", "shear-wave-3d": "safety/2",
                  "sliding-layer-2d": None, "sliding-layer-3d": None,
-                 "crown-base-quick": "safety/2"}
+                 "crown-base-quick": "safety/2",
+                 # the surface-stress model's drops (tension_cases.py): the quick set checks
+                 # one other gradient form on the free drop and safety/2 in 3D
+                 "laplace-2d-stress": None, "laplace-3d-stress": None,
+                 "drop-oscillation-2d-stress": None, "drop-oscillation-3d-stress": None,
+                 "free-drop-2d-stress": "gradient=pmin"}
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:
@@ -357,6 +365,8 @@ def all_cases(full: bool = True) -> Dict[str, Case]:
                          _sliding_layer)
              for d in (2, 3)]
     cases.append(crown_case("quick"))
+    from .tension_cases import tension_cases
+    cases += tension_cases()
     cases = [replace(c, quick_variant=QUICK_VARIANT.get(c.name, "")) for c in cases]
     if full:
         # the seed's first run, to 1 ms (the drafts' 2 ms at the finest spacing would take

@@ -40,7 +40,7 @@ def run_one(case: Case, scale: float, variant: str = "base") -> Row:
     """One case at one resolution and one settings variant (the backend's precision must
     already be the variant's)."""
     l0 = case.l0_of(scale)
-    numerics = variant_numerics(variant, Numerics())
+    numerics = variant_numerics(variant, case.base(Numerics()))
     opts = {"trim": False} if variant == "untrimmed" else {}
     t0 = time.perf_counter()
     try:

@@ -1,0 +1,171 @@
+"""Continuum surface stress (CSS): surface tension as the divergence of the capillary stress
+tensor (Lafaurie et al., J. Comput. Phys. 113, 1994; in SPH Hu & Adams, J. Comput. Phys. 213,
+2006), method.md §4c:
+
+    T = sigma (|g| I - g g^T / |g|),   a_st = (1/rho) div T                           (C2)
+
+with g the gradient of the liquid's colour (1 in the liquid, 0 outside). T is a tension along
+the surface layer with no normal component: on a flat surface its divergence vanishes, on a
+curved one it sums to sigma kappa n over the layer, the Young-Laplace jump, with no curvature
+computed. Two neighbour passes at r*, after the number density (S17):
+
+1. the colour gradient (C1), g_i = omega_i K sum_j r_ij f(r_ij) over every neighbour kind,
+   f(r) = (1 - r/re)^3 (a Wendland C2 kernel's gradient: bounded where the MPS w/r^2 is not;
+   with w/r^2 a closing pair's g grew as 1/r^2 and pulled the pair together), K = d / sum_j
+   r^2 f on the lattice. The missing neighbours of a surface particle make it point into the
+   liquid; the plane floor's wall and dummy layers add their share, so a wall is no surface.
+   omega_i = clamp((1 - n_i/n0) / (2 (1 - beta)), 0, 1) keeps it to the free surface (n <
+   n0): inside a disordered liquid g is not zero, and without omega that noise made an
+   isotropic tension that raised a resting drop's pressure to 1.8 sigma/R at R/l0 = 16;
+   then T_i = sigma a (|g_i| I - g_i g_i^T / |g_i|), a the lattice normaliser that makes a
+   flat lattice surface carry exactly sigma (lattice.stress_normaliser);
+2. the divergence in the sum form (C3),
+   a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij),  f_d(r) = 1 - (r/re)^4,
+   T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d. Each pair's terms are equal
+   and opposite (for a fluid j), so the model conserves momentum exactly: a free drop cannot
+   drift by its own surface tension. The pair force r f_d(r) grows with r up to 1.4 l0, so the
+   tension along the surface pulls two surface particles less as they close; with a pair
+   weight that peaks closer in (f, or w/r^2) the surface layer clumped within 2 ms. Below
+   l0, where no lattice pair lies (the normalisations do not see it), f_d is multiplied by
+   (r/l0 - 0.75)/0.25, so the tension turns into a repulsion for pairs closer than 0.75 l0:
+   free-surface particles have P = 0 (M3), and without the core two of them pulled together
+   met no pressure until n > n0, then a third one's arrival kicked one out of a resting drop
+   at 0.2-0.4 m/s (R/l0 = 8, once in 95 ms at c = 13 m/s, several at 2.7 m/s; with the core
+   none, and the largest speed stays under 6 mm/s). The idea is the repulsive core of the
+   seed's potential (S22, r < l0) and Monaghan's (2000) cure for the tensile instability.
+
+The acceleration is applied in the corrector with the pressure gradient (S18-S20), at r*.
+Only fluid particles carry tension; with symmetry planes, images carry their sources' mirrored
+g (``_sync_images``).
+"""
+import taichi as ti
+
+from ..coefficients import Coefficients
+from ..grid import CellGrid
+from ..params import Model
+from ..state import FLUID, GONE, field_nbytes
+
+CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
+
+
+@ti.func
+def stress_kernel(r, re):
+    """f(r) = (1 - r/re)^3 (C1; lattice.stress_kernel): bounded, zero at re."""
+    q = 1.0 - r / re
+    return q * q * q
+
+
+@ti.func
+def stress_pair_kernel(r, re, l0):
+    """f_d(r) = 1 - (r/re)^4 (C3; lattice.stress_pair_kernel), times (r/l0 - CORE)/(1 - CORE)
+    below l0 (the core: no lattice pair lies there)."""
+    q = r / re
+    f = 1.0 - q * q * q * q
+    if r < l0:
+        f *= (r / l0 - CORE) / (1.0 - CORE)
+    return f
+
+
+@ti.func
+def stress_times(g, r):
+    """(|g| I - g g^T/|g|) r without forming the tensor; 0 where g = 0."""
+    out = ti.Vector.zero(float, r.n)
+    gl = g.norm()
+    if gl > 0.0:
+        out = gl * r - g * (g.dot(r) / gl)
+    return out
+
+
+@ti.data_oriented
+class StressTension:
+    name = "stress"
+    pair_term = False          # acts in the corrector (``corrector_term``), not the predictor
+    corrector_term = True
+
+    def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
+        self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
+        self.dim = model.dim
+        cap = self.state.capacity
+        self.colour = ti.Vector.field(self.dim, float, cap)   # g_i (C1) [1/m]
+        self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
+        self.floor = None        # the analytic plane floor, where the model has one
+        self.symmetry = None     # the mirror planes, where the scene has them
+
+    def attach(self, floor, symmetry) -> None:
+        """The simulator's plane floor and symmetry planes (None where it has none)."""
+        self.floor, self.symmetry = floor, symmetry
+
+    def nbytes(self) -> int:
+        return field_nbytes(self.colour) + field_nbytes(self.accel)
+
+    def boundary_pressure(self) -> None:
+        """The two passes at r* (module docstring); the pressure is left as S17/M3 set it."""
+        self._colour()
+        if self.symmetry is not None:
+            self._sync_images()
+        self._divergence()
+
+    @ti.func
+    def _colour_pair(self, i, j, rij, r2, acc: ti.template()):
+        if self.state.kind[j] != GONE:
+            acc += rij * stress_kernel(ti.sqrt(r2), self.coef.re[None])
+
+    @ti.kernel
+    def _colour(self):
+        """Pass 1: g_i for fluid particles (0 for the others: walls carry no tension)."""
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
+            g = ti.Vector.zero(float, self.dim)
+            if self.state.kind[i] == FLUID:
+                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                             self._colour_pair, g)
+                if ti.static(self.model.plane_floor):
+                    g[self.dim - 1] += self.floor.colour_at(self.state.pos[i][self.dim - 1])
+            self.colour[i] = self._surface_weight(i) * self.coef.stress_K[None] * g
+
+    @ti.func
+    def _surface_weight(self, i):
+        """omega_i = clamp((1 - n_i/n0) / (2 (1 - beta)), 0, 1) (C1): 1 on the free surface's
+        outer layer (n ~ 0.5-0.75 n0), 1/2 at the free-surface threshold beta n0 (M3), 0 at
+        n >= n0, so the colour gradient's noise inside a disordered liquid carries no tension."""
+        n0 = self.coef.n0[None]
+        x = (1.0 - self.state.density[i] / n0) / (2.0 * (1.0 - self.coef.beta[None]))
+        return ti.min(ti.max(x, 0.0), 1.0)
+
+    @ti.kernel
+    def _sync_images(self):
+        """Images take their sources' g, reflected across their planes."""
+        n = self.state.n[None]
+        for s in range(n, n + self.state.n_images[None]):
+            self.colour[s] = self.symmetry._mirrored(self.colour[self.symmetry.source[s]], s)
+
+    @ti.func
+    def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+        kind_j = self.state.kind[j]
+        if kind_j != GONE:
+            f = stress_times(self.colour[i], rij)
+            if kind_j == FLUID:
+                f += stress_times(self.colour[j], rij)
+            acc += f * stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], self.coef.l0[None])
+
+    @ti.kernel
+    def _divergence(self):
+        """Pass 2: a_i = (d/(n0 rho)) sigma a sum_j (T_i + T_j) r_ij w / r^2 (C3)."""
+        scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
+            self.coef.rho[None])
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
+            if self.state.kind[i] == FLUID:
+                acc = ti.Vector.zero(float, self.dim)
+                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                             self._divergence_pair, acc)
+                if ti.static(self.model.plane_floor):
+                    ez = ti.Vector.zero(float, self.dim)
+                    ez[self.dim - 1] = self.floor.colour_at(self.state.pos[i][self.dim - 1])
+                    acc += stress_times(self.colour[i], ez)
+                self.accel[i] = scale * acc
+
+    @ti.func
+    def acceleration(self, i):
+        """a_i of the last ``boundary_pressure``, for the corrector (S18)."""
+        return self.accel[i]

@@ -1,0 +1,209 @@
+"""The surface-stress member (core/surface_tension/stress.py, method.md §4c): the lattice
+constants, the force on a flat and a curved surface, Newton's third law, and the resting and
+free 2D drops of `crowndemo validate` at their quick resolution.
+
+Expected values come from geometry and mechanics: the discrete gradient of a unit step
+integrates to 1/2 across a lattice surface (C1, see the test); a flat surface feels no normal
+force; the pull of a closed 2D membrane of tension sigma on its inside totals 2 pi sigma
+whatever its radius; pair forces sum to zero.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from crowndemo.core import FLUID, Numerics, Physics, Simulator
+from crowndemo.core.lattice import (colour_gradient_column, lattice_offsets, stress_gradient_norm,
+                                    stress_kernel, stress_normaliser, stress_pair_kernel)
+from crowndemo.core.surface_tension import MODELS, StressTension
+
+L0 = 1.0e-4
+SIGMA = 0.0728
+RHO = 998.0
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_colour_gradient_of_a_step_integrates_to_one_half(dim):
+    """Across a flat lattice surface sum_k |g_k| l0 = 1/2: per unit area the pairs that cross
+    a plane between layers carry (1/V0) sum_{r_z > 0} r_z^2 f = (1/2)(1/d) sum_j r^2 f = 1/(2K)
+    (the lattice's symmetry), times K."""
+    g = colour_gradient_column(dim, L0, 2.1 * L0)
+    assert float(g.sum()) * L0 == pytest.approx(0.5, rel=1e-12)
+    # the gradient of a linear field is exact with K (C3's normalisation, also for f_d)
+    for kernel in (stress_kernel, stress_pair_kernel):
+        offs = lattice_offsets(dim, L0, 2.1 * L0)
+        K = stress_gradient_norm(dim, L0, 2.1 * L0, kernel)
+        grad = K * (offs * (offs @ np.arange(1.0, dim + 1))[:, None]
+                    * kernel(np.linalg.norm(offs, axis=1), 2.1 * L0)[:, None]).sum(axis=0)
+        np.testing.assert_allclose(grad, np.arange(1.0, dim + 1), rtol=1e-12)
+    # the normaliser is dimensionless: the same at any spacing
+    assert stress_normaliser(dim, 1.0, 2.1) == pytest.approx(stress_normaliser(dim, L0, 2.1 * L0),
+                                                             rel=1e-9)
+
+
+def simulator(dim: int, capacity: int) -> Simulator:
+    phys = Physics(dim=dim, l0=L0, v_max=1.0, nu=0.0, sigma=SIGMA, gravity=0.0, rho=RHO)
+    sim = Simulator(phys, Numerics(surface_tension="stress", pressure_gradient="sum",
+                                   collision=0.0), capacity)
+    assert isinstance(sim.surface_tension, StressTension)
+    return sim
+
+
+@pytest.fixture(scope="module")
+def sim2():
+    return simulator(2, 4000)
+
+
+def stress_acceleration(sim: Simulator, pos: np.ndarray):
+    """The member's acceleration (C3) after the number density at ``pos``, with the positions
+    as the device holds them."""
+    sim.load(pos, np.zeros_like(pos), np.full(len(pos), FLUID, dtype=np.int32))
+    sim.grid.build(sim.lattice.re)
+    sim.pressure.density_and_pressure()
+    n = sim.state.count
+    return (sim.surface_tension.accel.to_numpy()[:n].astype(float),
+            sim.state.pos.to_numpy()[:n].astype(float))
+
+
+def test_flat_surface_feels_no_normal_force(sim2):
+    """The top of a lattice slab, away from its ends: T has no normal component there and the
+    in-layer pulls cancel, so the acceleration vanishes (to float rounding of the pulls)."""
+    side = 40
+    pts = np.stack(np.meshgrid(np.arange(side) + 0.5, np.arange(6) + 0.5, indexing="ij"),
+                   -1).reshape(-1, 2) * L0
+    a, pos = stress_acceleration(sim2, pts)
+    inside = (pos[:, 0] > 4 * L0) & (pos[:, 0] < (side - 4) * L0)
+    # the scale: the pull of one in-layer neighbour, sigma a K_d |g| l0^2 f_d(l0) / (rho l0^2)
+    scale = SIGMA / (RHO * L0 ** 2)
+    assert np.abs(a[inside]).max() < 1e-4 * scale
+    # while the slab's ends, curved at the lattice's corners, are pulled in
+    assert np.abs(a).max() > 0.1 * scale
+
+
+def test_pair_forces_sum_to_zero(sim2):
+    """Newton's third law: over a jittered cloud the forces of the member sum to zero
+    against the sum of their sizes (float32 rounding)."""
+    rng = np.random.default_rng(1)
+    pts = np.stack(np.meshgrid(np.arange(20), np.arange(14), indexing="ij"), -1).reshape(-1, 2)
+    pts = (pts + rng.uniform(-0.3, 0.3, pts.shape)) * L0
+    a, _ = stress_acceleration(sim2, pts)
+    assert np.abs(a).sum() > 0
+    assert np.linalg.norm(a.sum(axis=0)) < 1e-5 * np.abs(a).sum()
+
+
+@pytest.mark.parametrize("R", [8, 16])
+def test_membrane_pull_on_a_disc(sim2, R):
+    """Rings of particles l0 apart, the outermost at R - l0/2: the total inward pull per unit
+    depth, sum_i rho l0^2 a_i . r_hat, is that of a closed membrane of tension sigma, 2 pi
+    sigma, for any radius. Within 12 %: the normaliser a is the flat lattice face's (C2), and
+    on rings the surface layer's colour gradient is larger by the arrangement (measured
+    +9.8 % at R/l0 = 8, +7.8 % at 16; the staircase of a lattice-cut disc gives -6.5 %)."""
+    pts = [np.zeros((1, 2))]
+    for k in range(R):
+        r = R - 0.5 - k
+        count = max(int(round(2.0 * math.pi * r)), 1)
+        ang = 2.0 * math.pi * (np.arange(count) + 0.5 * (k % 2)) / count
+        pts.append(np.stack([r * np.cos(ang), r * np.sin(ang)], axis=1))
+    a, pos = stress_acceleration(sim2, np.concatenate(pts) * L0)
+    rhat = pos / np.maximum(np.linalg.norm(pos, axis=1), 1e-30)[:, None]
+    pull = -(RHO * L0 ** 2 * (a * rhat).sum(axis=1)).sum()
+    assert pull == pytest.approx(2.0 * math.pi * SIGMA, rel=0.12)
+
+
+def test_member_registered():
+    assert MODELS["stress"] is StressTension
+    assert Numerics(surface_tension="stress").validate().surface_tension == "stress"
+
+
+# ---- the quick rows of `crowndemo validate` (validate/tension_cases.py) -----------------------
+def test_resting_drop_holds_the_laplace_pressure():
+    """laplace-2d-stress at R/l0 = 12 (its quick row): inside pressure within 10 % of sigma/R
+    (issue 23), and
+    the drop does not move (momentum is conserved pair by pair)."""
+    from crowndemo.validate.cases import all_cases
+    from crowndemo.validate.runner import run_one
+    row = run_one(all_cases(full=False)["laplace-2d-stress"], 12)
+    assert row.outcome == "ok"
+    assert row.reference == pytest.approx(SIGMA / 1.0e-3)
+    assert row.error < 0.10
+    assert row.extra["drift_over_R"] < 1e-3
+
+
+def test_free_drop_holds_still():
+    """free-drop-2d-stress at R/l0 = 8: over 10 mode-2 periods the centre of mass moves less
+    than 0.01 R (issue 23). The issue's turn, < 0.05 rad, is met from R/l0 = 12 on (0.045 at
+    12, 0.016 at 16 in VALIDATION.md; 0.14 at 8): not checked at this resolution."""
+    from crowndemo.validate.cases import all_cases
+    from crowndemo.validate.runner import run_one
+    row = run_one(all_cases(full=False)["free-drop-2d-stress"], 8)
+    assert row.outcome == "ok"
+    assert row.measured < 0.01
+
+
+def test_half_drop_with_a_mirror_plane_has_the_whole_drops_stress():
+    """A resting 2D drop cut by the plane x = 0: with the images (and their mirrored colour
+    gradients, stress._sync_images) every particle of the half has the acceleration it has
+    in the whole drop."""
+    from dataclasses import replace as _replace
+
+    from crowndemo.core import simulator_for
+    from crowndemo.scenes.drop import resting_drop
+    from crowndemo.scenes.symmetric import halve
+    num = Numerics(surface_tension="stress", pressure_gradient="sum")
+    whole = resting_drop(dim=2, radius=1.0e-3, l0=L0 * 1.25, numerics=num)
+    part = halve(_replace(whole, numerics=_replace(num, mirror_planes=(0,))), (0,), [0.0, 0.0])
+    out = []
+    for scene in (whole, part):
+        sim = simulator_for(scene)
+        sim.refresh_pressure()
+        n = sim.state.count
+        out.append((sim.state.pos.to_numpy()[:n].astype(float),
+                    sim.surface_tension.accel.to_numpy()[:n].astype(float)))
+    (pw, aw), (pp, ap) = out
+    index = {tuple(np.round(p / L0, 3)): a for p, a in zip(pw, aw)}
+    expected = np.array([index[tuple(np.round(p / L0, 3))] for p in pp])
+    assert len(pp) < len(pw) and np.abs(expected).max() > 0
+    np.testing.assert_allclose(ap, expected, atol=1e-4 * np.abs(expected).max())
+
+
+def test_info_names_the_model_and_its_constants(capsys):
+    """`crowndemo info` says which surface-tension model a preset uses, with its constants
+    (the lattice's: C for the potential, a, K, K_d for the stress)."""
+    import json
+
+    from crowndemo.cli import main
+    from crowndemo.core.lattice import LatticeConstants
+    assert main(["info", "quick-2d", "--json"]) == 0
+    st = json.loads(capsys.readouterr().out)["surface_tension"]
+    assert st["model"] == "potential" and st["constants"]["C"] < 0
+    assert main(["info", "quick-2d", "--json", "--set", "numerics.surface_tension=stress"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    st = data["surface_tension"]
+    lat = LatticeConstants.compute(2, data["l0_m"], data["re_ratio"], 998.0, 0.0728)
+    assert st["model"] == "stress"
+    assert st["constants"]["a"] == pytest.approx(stress_normaliser(2, 1.0, 2.1), rel=1e-9)
+    assert st["constants"]["K_1_m2"] == pytest.approx(lat.stress_K, rel=1e-9)
+    assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress"]) == 0
+    assert "tension     stress: the continuum surface stress" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_plane_floor_is_no_free_surface(dim):
+    """The analytic floor's colour sum (plane_floor.c_floor) completes a fluid particle's
+    neighbourhood: in the fluid lattice resting on it (centres at s = (k + 1/2) l0) the colour
+    gradient's fluid part plus the floor's is zero, as in a whole lattice."""
+    from crowndemo.core.lattice import wall_layers
+    from crowndemo.core.plane_floor import FLOOR_C, floor_tables
+    re = 2.1 * L0
+    # 75 samples from -l0/4 to re - l0/2 = 1.6 l0: every 0.025 l0, s = l0/2 and 3 l0/2 on it
+    s0, ds, table = floor_tables(dim, L0, re, wall_layers(2.1), samples=75)
+    offs = lattice_offsets(dim, L0, re)
+    f = stress_kernel(np.linalg.norm(offs, axis=1), re)
+    for k in range(2):
+        s = (k + 0.5) * L0
+        row = int(round((s - s0) / ds))
+        assert s0 + row * ds == pytest.approx(s, abs=1e-6 * L0)
+        fluid = s + offs[:, -1] > 0.0                 # the fluid lattice's points within re
+        g_fluid = float((offs[fluid, -1] * f[fluid]).sum())
+        assert abs(g_fluid) > 0.0
+        assert g_fluid + table[row, FLOOR_C] == pytest.approx(0.0, abs=1e-9 * abs(g_fluid))
