@@ -24,8 +24,10 @@ examples:
   crowndemo validate --list
   crowndemo validate --record                    # also rewrite VALIDATION.md
 
-Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer (each
--2d and -3d), crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. Each case runs
+Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer,
+stress-laplace, stress-drop-oscillation (each -2d and -3d), stress-free-drop,
+crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. The stress- cases run the
+surface-stress model (method.md §4c) with the sum gradient form (stress-free-drop: -2d only). Each case runs
 at three resolutions in the base settings and, at the middle one, in its settings variants
 (--list says which case runs which):
   {variants}

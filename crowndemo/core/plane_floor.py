@@ -8,7 +8,7 @@ lattice continued below the surface, wall particles at s = -l0/2 and ``layers - 
 layers under them. The tables are summed for a particle right above a column of that lattice,
 so a fluid lattice at rest sees exactly the number density it would see with the particles;
 a particle between columns sees the same values (the particle floor's lateral ripple is left
-out). Per height s, four sums over the layers' points j within re:
+out). Per height s, five sums over the layers' points j within re:
 
 - n_floor(s) = sum over every layer of w(r)                 -> number density (S9)
 - g_floor(s) = sum over the wall layer of (z_j - z_i) w / r^2 -> pressure gradient (S11), the
@@ -18,6 +18,7 @@ out). Per height s, four sums over the layers' points j within re:
 - v_floor(s) = sum over the wall layer of w(r)              -> viscosity (S12), u_j = 0
 - c_floor(s) = sum over every layer of (z_j - z_i) f(r)     -> the surface-stress model's
   colour gradient (method.md C1): the floor is no free surface
+- d_floor(s) = sum over every layer of (z_j - z_i) f_d(r)   -> its divergence (C3), T_j = 0
 
 and a particle closer than the collision distance to the wall layer's plane loses its
 approach speed as against a wall particle (the collision model, terms.py).
@@ -30,16 +31,16 @@ from typing import Tuple
 import numpy as np
 import taichi as ti
 
-from .lattice import stress_kernel, weight
+from .lattice import stress_kernel, stress_pair_kernel, weight
 
 SAMPLES = 1024
-FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C = 0, 1, 2, 3
+FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C, FLOOR_D = 0, 1, 2, 3, 4
 
 
 def floor_tables(dim: int, l0: float, re: float, layers: int,
                  samples: int = SAMPLES) -> Tuple[float, float, np.ndarray]:
-    """(s0, ds, table[samples, 4]): n_floor, g_floor (the component along the last axis),
-    v_floor and c_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
+    """(s0, ds, table[samples, 5]): n_floor, g_floor (the component along the last axis),
+    v_floor, c_floor and d_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
     collision model has acted; the table holds its last value) to re - l0/2 (beyond, no floor
     point is within re)."""
     s0, s1 = -0.25 * l0, re - 0.5 * l0
@@ -48,7 +49,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
     lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
     lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
     lat2 = (lateral ** 2).sum(axis=1)
-    table = np.zeros((samples, 4))
+    table = np.zeros((samples, 5))
     for k in range(samples):
         s = s0 + k * ds
         for layer in range(layers):
@@ -57,6 +58,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
             w = weight(r, re)
             table[k, FLOOR_N] += w.sum()
             table[k, FLOOR_C] += (dz * stress_kernel(r, re)).sum()
+            table[k, FLOOR_D] += (dz * stress_pair_kernel(r, re)).sum()
             if layer == 0:
                 table[k, FLOOR_G] += (dz / (r * r) * w).sum()
                 table[k, FLOOR_V] += w.sum()
@@ -66,7 +68,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
 @ti.data_oriented
 class PlaneFloor:
     def __init__(self):
-        self.table = ti.Vector.field(4, float, SAMPLES)
+        self.table = ti.Vector.field(5, float, SAMPLES)
         self.s0 = ti.field(float, shape=())
         self.inv_ds = ti.field(float, shape=())
         self.wall_depth = ti.field(float, shape=())    # the wall layer's plane: s = -l0/2
@@ -85,8 +87,8 @@ class PlaneFloor:
 
     @ti.func
     def at(self, s):
-        """(n_floor, g_floor, v_floor, c_floor) at height s, linear between samples; zero past
-        the top."""
+        """(n_floor, g_floor, v_floor, c_floor, d_floor) at height s, linear between samples;
+        zero past the top."""
         # clamped before the cast: a height far up (or inf, NaN) would cast to INT_MIN
         x = ti.min((ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None],
                    float(SAMPLES - 1))
@@ -100,5 +102,11 @@ class PlaneFloor:
         """c_floor at height s (the module docstring's fourth sum)."""
         return self.at(s)[FLOOR_C]
 
+    @ti.func
+    def divergence_at(self, s):
+        """d_floor at height s (the module docstring's fifth sum)."""
+        return self.at(s)[FLOOR_D]
 
-__all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V", "FLOOR_C"]
+
+__all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V", "FLOOR_C",
+           "FLOOR_D"]

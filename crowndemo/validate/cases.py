@@ -355,9 +355,9 @@ QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "crown-base-quick": "safety/2",
                  # the surface-stress model's drops (tension_cases.py): the quick set checks
                  # one other gradient form on the free drop and safety/2 in 3D
-                 "laplace-2d-stress": None, "laplace-3d-stress": None,
-                 "drop-oscillation-2d-stress": None, "drop-oscillation-3d-stress": None,
-                 "free-drop-2d-stress": "gradient=pmin"}
+                 "stress-laplace-2d": None, "stress-laplace-3d": None,
+                 "stress-drop-oscillation-2d": None, "stress-drop-oscillation-3d": None,
+                 "stress-free-drop-2d": "gradient=pmin"}
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:

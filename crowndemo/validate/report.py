@@ -73,6 +73,10 @@ def write_csv(rows: Sequence, path: str) -> None:
 # the last part of a case's name says which member of its family it is: a family (the same
 # physics) shares a colour, its members differ in line style (2D solid, 3D dashed)
 MEMBER_STYLES = {"-2d": "-", "-3d": "--", "-quick": "-", "-3m-drop": "--"}
+# matplotlib's ten cycle colours, then the ten lighter ones of its tab20 map
+PALETTE = tuple(f"C{k}" for k in range(10)) + (
+    "#aec7e8", "#ffbb78", "#98df8a", "#ff9896", "#c5b0d5", "#c49c94", "#f7b6d2", "#c7c7c7",
+    "#dbdb8d", "#9edae5")
 
 
 def case_styles(names: Iterable[str]) -> Dict[str, Tuple[str, str]]:
@@ -83,7 +87,7 @@ def case_styles(names: Iterable[str]) -> Dict[str, Tuple[str, str]]:
     for name in sorted(names):
         suffix = next((s for s in MEMBER_STYLES if name.endswith(s)), "")
         family = families.setdefault(name[:len(name) - len(suffix)], len(families))
-        styles[name] = (f"C{family % 10}", MEMBER_STYLES.get(suffix, ":"))
+        styles[name] = (PALETTE[family % len(PALETTE)], MEMBER_STYLES.get(suffix, ":"))
     return styles
 
 

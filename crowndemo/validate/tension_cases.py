@@ -92,7 +92,7 @@ def _laplace(dim: int) -> Case:
                        {"drift_over_R": watch.drift() / R, "p_in_spread_Pa": float(
                            np.max(watch.p_in) - np.min(watch.p_in))})
 
-    return Case(f"laplace-{dim}d-stress", dim,
+    return Case(f"stress-laplace-{dim}d", dim,
                 "surface stress: pressure inside a resting drop (r < R/2, EOS, over mode-2 "
                 "periods 2.5-5) [Pa]", "sigma/R (2D), 2 sigma/R (3D) (method.md §7)", "R/l0",
                 (8, 12, 16), (12,) if dim == 2 else (8,), lambda s: R / s, run,
@@ -116,7 +116,7 @@ def _oscillation(dim: int) -> Case:
         return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay,
                                               "drift_over_R": watch.drift() / R})
 
-    return Case(f"drop-oscillation-{dim}d-stress", dim,
+    return Case(f"stress-drop-oscillation-{dim}d", dim,
                 "surface stress: mode-2 angular frequency [rad/s]",
                 "Rayleigh-Lamb (method.md §7)", "R/l0",
                 (8, 12, 16) if dim == 2 else (8, 10, 12), (8,), lambda s: R / s, run,
@@ -140,7 +140,7 @@ def _free_drop(dim: int) -> Case:
                                                     watch.p_in[len(watch.p_in) // 2:])) / (
                                                     (dim - 1) * sim.physics.sigma / R)})
 
-    return Case(f"free-drop-{dim}d-stress", dim,
+    return Case(f"stress-free-drop-{dim}d", dim,
                 "surface stress: centre-of-mass drift over 10 mode-2 periods / R",
                 "0 (a free drop holds still; issue 23: < 0.01 R, turn < 0.05 rad)", "R/l0",
                 (8, 12, 16), (8,), lambda s: R / s, run,

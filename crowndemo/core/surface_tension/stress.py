@@ -150,7 +150,8 @@ class StressTension:
 
     @ti.kernel
     def _divergence(self):
-        """Pass 2: a_i = (d/(n0 rho)) sigma a sum_j (T_i + T_j) r_ij w / r^2 (C3)."""
+        """Pass 2: a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij) (C3), T = sigma a (|g| I -
+        g g^T/|g|) (C2), T_j = 0 for walls and dummies (the plane floor's layers: d_floor)."""
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
         for at in range(self.state.n[None]):
@@ -161,7 +162,7 @@ class StressTension:
                                              self._divergence_pair, acc)
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
-                    ez[self.dim - 1] = self.floor.colour_at(self.state.pos[i][self.dim - 1])
+                    ez[self.dim - 1] = self.floor.divergence_at(self.state.pos[i][self.dim - 1])
                     acc += stress_times(self.colour[i], ez)
                 self.accel[i] = scale * acc
 
