@@ -16,12 +16,18 @@ from typing import List
 import numpy as np
 
 from ..core import Numerics
+from ..core.params import WATER
 from ..scenes.drop import mode2_omega, oscillating_drop, resting_drop
 from . import oscillation
 from .cases import Case, Outcome, simulator
 
 R = 1.0e-3                 # drop radius [m]
 FORM = "sum"               # the drops' gradient form (module docstring)
+
+
+def mode2_period(dim: int) -> float:
+    """The mode-2 period of the cases' water drop of radius R (Rayleigh, method.md §7) [s]."""
+    return 2 * math.pi / mode2_omega(dim, R, WATER["sigma"], WATER["rho"])
 
 
 def stress_numerics(numerics: Numerics) -> Numerics:
@@ -80,7 +86,7 @@ def _laplace(dim: int) -> Case:
     periods = 5.0
 
     def run(l0: float, numerics: Numerics) -> Outcome:
-        t_end = periods * 2 * math.pi / mode2_omega(dim, R, 0.0728, 998.0)
+        t_end = periods * mode2_period(dim)
         scene = resting_drop(dim=dim, radius=R, l0=l0, nu=1.0e-4, t_end=t_end,
                              numerics=numerics)
         sim = simulator(scene)
@@ -127,7 +133,7 @@ def _free_drop(dim: int) -> Case:
     periods = 10.0
 
     def run(l0: float, numerics: Numerics) -> Outcome:
-        period = 2 * math.pi / mode2_omega(dim, R, 0.0728, 998.0)
+        period = mode2_period(dim)
         scene = resting_drop(dim=dim, radius=R, l0=l0, nu=1.0e-4, t_end=periods * period,
                              numerics=numerics)
         sim = simulator(scene)
