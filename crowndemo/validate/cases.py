@@ -354,7 +354,7 @@ QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "sliding-layer-2d": None, "sliding-layer-3d": None,
                  "crown-base-quick": "safety/2",
                  # the surface-stress model's drops (tension_cases.py): the quick set checks
-                 # one other gradient form on the free drop and safety/2 in 3D
+                 # one other gradient form, on the free drop (each form compiles a model)
                  "stress-laplace-2d": None, "stress-laplace-3d": None,
                  "stress-drop-oscillation-2d": None, "stress-drop-oscillation-3d": None,
                  "stress-free-drop-2d": "gradient=pmin"}
