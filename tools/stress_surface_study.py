@@ -1,0 +1,146 @@
+"""The surface-stress member's resting-drop diagnostics of VALIDATION.md ("What the surface
+layer does", issue 23), reproducible:
+
+    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours]
+                                                   [--core X]
+    .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [--surface neighbours]
+
+``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
+inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
+Laplace pull ((d - 1) sigma / R times the drop's area), the surface layer (|g| l0 > 1/4): its
+size, mean radius, mean nearest-neighbour spacing, the share of it at P = 0, the share of the
+pull it carries. ``case``: one row of a stress-* validation case (validate/tension_cases.py).
+
+``--surface neighbours``: an experiment, not a member option: free-surface particles (P = 0 after
+S17/M3) take the w-weighted mean pressure of their pressurised fluid neighbours before the stress
+passes. ``--core X``: the repulsive core's zero (stress.CORE, default 0.75) for this run.
+Runs on one thread (``--threads``) so that it can run beside a long recording."""
+import argparse
+import math
+import time
+
+import numpy as np
+import taichi as ti
+
+from crowndemo import backend
+
+
+def neighbours_pressure_member():
+    """The stress member with the ``--surface neighbours`` pass (module docstring)."""
+    from crowndemo.core.operators import weight
+    from crowndemo.core.state import FLUID
+    from crowndemo.core.surface_tension.stress import StressTension
+
+    @ti.data_oriented
+    class NeighbourPressureStress(StressTension):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.p_new = ti.field(float, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._surface_pressure()
+            self._commit()
+            super().boundary_pressure()
+
+        @ti.func
+        def _pressurised(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] == FLUID and self.state.pressure[j] > 0.0:
+                w = weight(ti.sqrt(r2), self.coef.re[None])
+                acc += ti.Vector([w * self.state.pressure[j], w])
+
+        @ti.kernel
+        def _surface_pressure(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.p_new[i] = self.state.pressure[i]
+                if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0:
+                    acc = ti.Vector([0.0, 0.0])
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._pressurised, acc)
+                    if acc[1] > 0.0:
+                        self.p_new[i] = acc[0] / acc[1]
+
+        @ti.kernel
+        def _commit(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.state.pressure[i] = self.p_new[i]
+
+    return NeighbourPressureStress
+
+
+def drop(dim: int, scale: float, t_ms: float) -> None:
+    from crowndemo.core.params import Numerics
+    from crowndemo.scenes.drop import resting_drop
+    from crowndemo.validate.cases import simulator
+    R, t_end = 1.0e-3, t_ms * 1e-3
+    l0 = R / scale
+    scene = resting_drop(dim=dim, radius=R, l0=l0, t_end=t_end, nu=1.0e-4,
+                         numerics=Numerics(pressure_gradient="sum", surface_tension="stress"))
+    sim = simulator(scene)
+    sigma, rho, n0 = sim.physics.sigma, sim.physics.rho, sim.lattice.n0
+    laplace = (dim - 1) * sigma / R
+    area = 2 * math.pi * R if dim == 2 else 4 * math.pi * R * R
+    print(f"{dim}D drop, R/l0 = {scale:g}, {len(scene.pos)} particles")
+    next_t = 0.0
+    while sim.stats.time < t_end:
+        sim.step()
+        if sim.stats.time < next_t:
+            continue
+        next_t += 0.5e-3
+        sim.refresh_pressure()
+        st, n = sim.surface_tension, sim.state.n[None]
+        pos = sim.state.pos.to_numpy()[:n].astype(float)
+        P = sim.state.pressure.to_numpy()[:n]
+        acc = st.accel.to_numpy()[:n].astype(float)
+        g = np.linalg.norm(st.colour.to_numpy()[:n].astype(float), axis=1) * l0
+        d = pos - pos.mean(axis=0)
+        r = np.linalg.norm(d, axis=1)
+        pull = -(acc * d / r[:, None]).sum(axis=1) * rho * l0 ** dim
+        surf = g > 0.25
+        ps = pos[surf]
+        gap = np.linalg.norm(ps[:, None] - ps[None], axis=2)
+        np.fill_diagonal(gap, np.inf)
+        print(f"t = {sim.stats.time * 1e3:5.2f} ms  P_in / Laplace {P[r < R / 2].mean() / laplace:.3f}"
+              f"  pull / Laplace pull {pull.sum() / (laplace * area):.3f}"
+              f"  surface: {surf.sum()} particles, r / R {r[surf].mean() / R:.3f},"
+              f" spacing / l0 {gap.min(axis=1).mean() / l0:.3f}, at P = 0 {(P[surf] <= 0).mean():.2f},"
+              f" pull share {pull[surf].sum() / pull.sum():.2f}  r_max / R {r.max() / R:.3f}",
+              flush=True)
+
+
+def case(name: str, scales: str) -> None:
+    from crowndemo.core import Numerics
+    from crowndemo.validate.tension_cases import tension_cases
+    chosen = {c.name: c for c in tension_cases()}[name]
+    for s in scales.split(","):
+        t0 = time.time()
+        out = chosen.run(1.0e-3 / float(s), chosen.base(Numerics()))
+        extra = ", ".join(f"{k} {v:.4g}" for k, v in out.extra.items())
+        print(f"{name} R/l0 = {s}: {out.measured:.4g} against {out.reference:.4g}, error "
+              f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("what", choices=("drop", "case"))
+    ap.add_argument("args", nargs="+")
+    ap.add_argument("--surface", choices=("zero", "neighbours"), default="zero")
+    ap.add_argument("--core", type=float, default=None)
+    ap.add_argument("--threads", type=int, default=1)
+    a = ap.parse_args()
+    backend.init("cpu", threads=a.threads)
+    import crowndemo.core.surface_tension as family
+    import crowndemo.core.surface_tension.stress as stress
+    if a.core is not None:
+        stress.CORE = a.core          # read when the member's kernels compile
+    if a.surface == "neighbours":
+        family.MODELS["stress"] = neighbours_pressure_member()
+    if a.what == "drop":
+        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]))
+    else:
+        case(a.args[0], a.args[1])
+
+
+if __name__ == "__main__":
+    main()
