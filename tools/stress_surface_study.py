@@ -1,9 +1,9 @@
 """The surface-stress member's resting-drop diagnostics of VALIDATION.md ("What the surface
 layer does", issue 23), reproducible:
 
-    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours]
-                                                   [--core X]
-    .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [--surface neighbours]
+    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours|own]
+                                                   [--core X] [--isotropic-core] [--every MS]
+    .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
 inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
@@ -11,9 +11,14 @@ Laplace pull ((d - 1) sigma / R times the drop's area), the surface layer (|g| l
 size, mean radius, mean nearest-neighbour spacing, the share of it at P = 0, the share of the
 pull it carries. ``case``: one row of a stress-* validation case (validate/tension_cases.py).
 
-``--surface neighbours``: an experiment, not a member option: free-surface particles (P = 0 after
-S17/M3) take the w-weighted mean pressure of their pressurised fluid neighbours before the stress
-passes. ``--core X``: the repulsive core's zero (stress.CORE, default 0.75) for this run.
+Experiments, not member options (VALIDATION.md says what each did):
+``--surface neighbours``: free-surface particles (P = 0 after S17/M3) take the w-weighted mean
+pressure of their pressurised fluid neighbours before the stress passes;
+``--surface own``: after the passes they take the normal stress their own tension carries,
+P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1);
+``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
+``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
+instead of through the tangential projection, so a surface particle cannot sink into a gap.
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
 import math
@@ -69,7 +74,58 @@ def neighbours_pressure_member():
     return NeighbourPressureStress
 
 
-def drop(dim: int, scale: float, t_ms: float) -> None:
+def own_pressure_member(factor: float):
+    """The stress member with the ``--surface own`` pass (module docstring)."""
+    from crowndemo.core.state import FLUID
+    from crowndemo.core.surface_tension.stress import StressTension
+
+    @ti.data_oriented
+    class OwnPressureStress(StressTension):
+        def boundary_pressure(self) -> None:
+            super().boundary_pressure()
+            self._own_pressure()
+
+        @ti.kernel
+        def _own_pressure(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                g = self.colour[i]
+                if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and g.norm() > 0.0:
+                    inward = self.accel[i].dot(g) / g.norm()
+                    self.state.pressure[i] = factor * self.coef.rho[None] * self.coef.l0[None] * (
+                        ti.max(inward, 0.0))
+
+    return OwnPressureStress
+
+
+def isotropic_core_member():
+    """The stress member with the ``--isotropic-core`` pair (module docstring)."""
+    from crowndemo.core.state import FLUID, GONE
+    from crowndemo.core.surface_tension.stress import (StressTension, stress_pair_kernel,
+                                                       stress_times)
+
+    @ti.data_oriented
+    class IsotropicCoreStress(StressTension):
+        @ti.func
+        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+            kind_j = self.state.kind[j]
+            if kind_j != GONE:
+                fd = stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], self.coef.l0[None])
+                if fd >= 0.0:
+                    f = stress_times(self.colour[i], rij)
+                    if kind_j == FLUID:
+                        f += stress_times(self.colour[j], rij)
+                    acc += f * fd
+                else:
+                    s = self.colour[i].norm()
+                    if kind_j == FLUID:
+                        s += self.colour[j].norm()
+                    acc += s * rij * fd
+
+    return IsotropicCoreStress
+
+
+def drop(dim: int, scale: float, t_ms: float, every_ms: float) -> None:
     from crowndemo.core.params import Numerics
     from crowndemo.scenes.drop import resting_drop
     from crowndemo.validate.cases import simulator
@@ -87,7 +143,7 @@ def drop(dim: int, scale: float, t_ms: float) -> None:
         sim.step()
         if sim.stats.time < next_t:
             continue
-        next_t += 0.5e-3
+        next_t += every_ms * 1e-3
         sim.refresh_pressure()
         st, n = sim.surface_tension, sim.state.n[None]
         pos = sim.state.pos.to_numpy()[:n].astype(float)
@@ -125,8 +181,11 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("what", choices=("drop", "case"))
     ap.add_argument("args", nargs="+")
-    ap.add_argument("--surface", choices=("zero", "neighbours"), default="zero")
+    ap.add_argument("--surface", choices=("zero", "neighbours", "own"), default="zero")
+    ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--core", type=float, default=None)
+    ap.add_argument("--isotropic-core", action="store_true")
+    ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     backend.init("cpu", threads=a.threads)
@@ -136,8 +195,14 @@ def main() -> None:
         stress.CORE = a.core          # read when the member's kernels compile
     if a.surface == "neighbours":
         family.MODELS["stress"] = neighbours_pressure_member()
+    elif a.surface == "own":
+        family.MODELS["stress"] = own_pressure_member(a.own_factor)
+    if a.isotropic_core:
+        if a.surface != "zero":
+            ap.error("--isotropic-core goes with --surface zero")
+        family.MODELS["stress"] = isotropic_core_member()
     if a.what == "drop":
-        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]))
+        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every)
     else:
         case(a.args[0], a.args[1])
 
