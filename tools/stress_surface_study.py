@@ -2,7 +2,7 @@
 layer does", issue 23), reproducible:
 
     .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours|own]
-                                                   [--core X] [--isotropic-core] [--every MS]
+                          [--core X] [--isotropic-core] [--tangential-moment] [--every MS]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
@@ -18,7 +18,12 @@ pressure of their pressurised fluid neighbours before the stress passes;
 P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1);
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
-instead of through the tangential projection, so a surface particle cannot sink into a gap.
+instead of through the tangential projection, so a surface particle cannot sink into a gap;
+``--tangential-moment``: after pass 1 each surface particle's g (so its tension) is scaled by
+c_i = B0 / B_i, B_i = sum_j |g_j| l0 (|r_ij|^2 - (r_ij . n_i)^2) / l0^2 f_d(r_ij) over fluid j,
+the surface's tangential moment about i (packing raises it), B0 its value at a flat lattice
+face's outer particle; c in [1/4, 4]; a third pass, drops only.
+The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
 import math
@@ -30,14 +35,13 @@ import taichi as ti
 from crowndemo import backend
 
 
-def neighbours_pressure_member():
-    """The stress member with the ``--surface neighbours`` pass (module docstring)."""
+def neighbours_pressure_member(base):
+    """``base`` with the ``--surface neighbours`` pass (module docstring)."""
     from crowndemo.core.operators import weight
     from crowndemo.core.state import FLUID
-    from crowndemo.core.surface_tension.stress import StressTension
 
     @ti.data_oriented
-    class NeighbourPressureStress(StressTension):
+    class NeighbourPressureStress(base):
         def __init__(self, model, grid, coef):
             super().__init__(model, grid, coef)
             self.p_new = ti.field(float, self.state.capacity)
@@ -74,13 +78,12 @@ def neighbours_pressure_member():
     return NeighbourPressureStress
 
 
-def own_pressure_member(factor: float):
-    """The stress member with the ``--surface own`` pass (module docstring)."""
+def own_pressure_member(base, factor: float):
+    """``base`` with the ``--surface own`` pass (module docstring)."""
     from crowndemo.core.state import FLUID
-    from crowndemo.core.surface_tension.stress import StressTension
 
     @ti.data_oriented
-    class OwnPressureStress(StressTension):
+    class OwnPressureStress(base):
         def boundary_pressure(self) -> None:
             super().boundary_pressure()
             self._own_pressure()
@@ -98,14 +101,13 @@ def own_pressure_member(factor: float):
     return OwnPressureStress
 
 
-def isotropic_core_member():
-    """The stress member with the ``--isotropic-core`` pair (module docstring)."""
+def isotropic_core_member(base):
+    """``base`` with the ``--isotropic-core`` pair (module docstring)."""
     from crowndemo.core.state import FLUID, GONE
-    from crowndemo.core.surface_tension.stress import (StressTension, stress_pair_kernel,
-                                                       stress_times)
+    from crowndemo.core.surface_tension.stress import stress_pair_kernel, stress_times
 
     @ti.data_oriented
-    class IsotropicCoreStress(StressTension):
+    class IsotropicCoreStress(base):
         @ti.func
         def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
             kind_j = self.state.kind[j]
@@ -123,6 +125,76 @@ def isotropic_core_member():
                     acc += s * rij * fd
 
     return IsotropicCoreStress
+
+
+def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
+    """B0: the tangential moment (``tangential_moment_member``) of an outer particle of a flat
+    lattice face, from the lattice's colour column (lattice.colour_gradient_column) times
+    omega of each layer (C1)."""
+    from crowndemo.core import lattice
+    offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
+    r = np.linalg.norm(offs, axis=1)
+    w = re_over_l0 / r - 1.0
+    column = lattice.colour_gradient_column(dim, 1.0, re_over_l0)
+    g = []
+    for k, gk in enumerate(column):
+        n_k = w[offs[:, -1] <= k + 1e-9].sum() / w.sum()      # layer k's number density
+        g.append(gk * min(max((1.0 - n_k) / (2.0 * (1.0 - beta)), 0.0), 1.0))
+    fd = lattice.stress_pair_kernel(r, re_over_l0)
+    layer = np.round(-offs[:, -1]).astype(int)                  # j's layer, i in layer 0
+    tangential = (offs[:, :-1] ** 2).sum(axis=1)
+    return float(sum(g[k] * t * f for k, t, f in zip(layer, tangential, fd)
+                     if 0 <= k < len(g)))
+
+
+def tangential_moment_member(base, beta: float, dim: int):
+    """``base`` with the ``--tangential-moment`` pass (module docstring)."""
+    from crowndemo.core.state import FLUID
+    from crowndemo.core.surface_tension.stress import stress_pair_kernel
+    B0 = lattice_moment(dim, beta)
+
+    @ti.data_oriented
+    class TangentialMomentStress(base):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.share = ti.field(float, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._colour()
+            if self.symmetry is not None:
+                raise SystemExit("--tangential-moment: drops only (no symmetry planes)")
+            self._moment()
+            self._scale()
+            self._divergence()
+
+        @ti.func
+        def _moment_pair(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] == FLUID:
+                l0 = self.coef.l0[None]
+                n = self.colour[i].normalized()
+                acc += self.colour[j].norm() * l0 * (r2 - rij.dot(n) ** 2) / (l0 * l0) * (
+                    stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0))
+
+        @ti.kernel
+        def _moment(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                c = 1.0
+                if self.state.kind[i] == FLUID and self.colour[i].norm() > 0.0:
+                    b = 0.0
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._moment_pair, b)
+                    if b > 0.0:
+                        c = ti.min(ti.max(B0 / b, 0.25), 4.0)
+                self.share[i] = c
+
+        @ti.kernel
+        def _scale(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.colour[i] *= self.share[i]
+
+    return TangentialMomentStress
 
 
 def drop(dim: int, scale: float, t_ms: float, every_ms: float) -> None:
@@ -185,6 +257,7 @@ def main() -> None:
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--core", type=float, default=None)
     ap.add_argument("--isotropic-core", action="store_true")
+    ap.add_argument("--tangential-moment", action="store_true")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
@@ -193,14 +266,17 @@ def main() -> None:
     import crowndemo.core.surface_tension.stress as stress
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
-    if a.surface == "neighbours":
-        family.MODELS["stress"] = neighbours_pressure_member()
-    elif a.surface == "own":
-        family.MODELS["stress"] = own_pressure_member(a.own_factor)
+    member = stress.StressTension
+    if a.tangential_moment:
+        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+        member = tangential_moment_member(member, 0.97 if dim == 2 else 0.98, dim)
     if a.isotropic_core:
-        if a.surface != "zero":
-            ap.error("--isotropic-core goes with --surface zero")
-        family.MODELS["stress"] = isotropic_core_member()
+        member = isotropic_core_member(member)
+    if a.surface == "neighbours":
+        member = neighbours_pressure_member(member)
+    elif a.surface == "own":
+        member = own_pressure_member(member, a.own_factor)
+    family.MODELS["stress"] = member
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every)
     else:
