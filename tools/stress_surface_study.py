@@ -134,7 +134,7 @@ def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
     from crowndemo.core import lattice
     offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
     r = np.linalg.norm(offs, axis=1)
-    w = re_over_l0 / r - 1.0
+    w = lattice.weight(r, re_over_l0)
     column = lattice.colour_gradient_column(dim, 1.0, re_over_l0)
     g = []
     for k, gk in enumerate(column):
@@ -160,9 +160,9 @@ def tangential_moment_member(base, beta: float, dim: int):
             self.share = ti.field(float, self.state.capacity)
 
         def boundary_pressure(self) -> None:
-            self._colour()
             if self.symmetry is not None:
                 raise SystemExit("--tangential-moment: drops only (no symmetry planes)")
+            self._colour()
             self._moment()
             self._scale()
             self._divergence()
@@ -264,12 +264,13 @@ def main() -> None:
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
     import crowndemo.core.surface_tension.stress as stress
+    from crowndemo.core import Numerics
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     member = stress.StressTension
     if a.tangential_moment:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
-        member = tangential_moment_member(member, 0.97 if dim == 2 else 0.98, dim)
+        member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim)
     if a.isotropic_core:
         member = isotropic_core_member(member)
     if a.surface == "neighbours":
