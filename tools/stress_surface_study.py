@@ -3,19 +3,23 @@ layer does", issue 23), reproducible:
 
     .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours|own]
                           [--core X] [--isotropic-core] [--tangential-moment] [--every MS]
+                          [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
 inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
 Laplace pull ((d - 1) sigma / R times the drop's area), the surface layer (|g| l0 > 1/4): its
-size, mean radius, mean nearest-neighbour spacing, the share of it at P = 0, the share of the
-pull it carries. ``case``: one row of a stress-* validation case (validate/tension_cases.py).
+size, mean radius, mean nearest-neighbour spacing, the share of it at P = 0, its mean pressure,
+the share of the pull it carries; the drop's largest radius and the pull's radius (the radius
+of each particle weighted by its radial tension force: where the pull acts). ``case``: one
+row of a stress-* validation case (validate/tension_cases.py).
 
 Experiments, not member options (VALIDATION.md says what each did):
 ``--surface neighbours``: free-surface particles (P = 0 after S17/M3) take the w-weighted mean
 pressure of their pressurised fluid neighbours before the stress passes;
 ``--surface own``: after the passes they take the normal stress their own tension carries,
-P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1);
+P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1); with
+``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle holds;
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -23,6 +27,10 @@ instead of through the tangential projection, so a surface particle cannot sink 
 c_i = B0 / B_i, B_i = sum_j |g_j| l0 (|r_ij|^2 - (r_ij . n_i)^2) / l0^2 f_d(r_ij) over fluid j,
 the surface's tangential moment about i (packing raises it), B0 its value at a flat lattice
 face's outer particle; c in [1/4, 4]; a third pass, drops only.
+``--membrane``: each pair's stress (T_i + T_j) weighted by phi_ij = 2 min(|g_i|, |g_j|) /
+(|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
+the tension acts between surface particles only (an inner particle, g = 0, takes none of the
+pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
@@ -78,8 +86,9 @@ def neighbours_pressure_member(base):
     return NeighbourPressureStress
 
 
-def own_pressure_member(base, factor: float):
-    """``base`` with the ``--surface own`` pass (module docstring)."""
+def own_pressure_member(base, factor: float, per_area: bool = False):
+    """``base`` with the ``--surface own`` pass (module docstring); ``per_area``: divided by
+    the tangential moment's c_i (the area a surface particle holds, over l0^2)."""
     from crowndemo.core.state import FLUID
 
     @ti.data_oriented
@@ -95,6 +104,8 @@ def own_pressure_member(base, factor: float):
                 g = self.colour[i]
                 if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and g.norm() > 0.0:
                     inward = self.accel[i].dot(g) / g.norm()
+                    if ti.static(per_area):
+                        inward /= self.share[i]
                     self.state.pressure[i] = factor * self.coef.rho[None] * self.coef.l0[None] * (
                         ti.max(inward, 0.0))
 
@@ -125,6 +136,62 @@ def isotropic_core_member(base):
                     acc += s * rij * fd
 
     return IsotropicCoreStress
+
+
+def membrane_weight(gi, gj, ref):
+    """phi_ij (``--membrane``) of |g_i| l0, |g_j| l0: 2 min / sum with ref = 0, else
+    min(1, |g_i| l0/ref) min(1, |g_j| l0/ref)."""
+    if ref <= 0.0:
+        return 2.0 * min(gi, gj) / (gi + gj) if gi + gj > 0 else 0.0
+    return min(1.0, gi / ref) * min(1.0, gj / ref)
+
+
+def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1) -> float:
+    """a_membrane / a: the flat lattice face's normaliser a (lattice.stress_normaliser) with
+    each pair's stress weighted by phi_ij = 2 min(|g_i|, |g_j|) / (|g_i| + |g_j|)
+    (``membrane_member``), over the member's a."""
+    from crowndemo.core import lattice
+    offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
+    f = lattice.stress_pair_kernel(np.linalg.norm(offs, axis=1), re_over_l0)
+    g = lattice.colour_gradient_column(dim, 1.0, re_over_l0)
+    full = part = 0.0
+    for k in range(len(g)):
+        for off, ff in zip(offs, f):
+            kj = k - int(round(off[-1]))
+            if off[0] > 0 and 0 <= kj < len(g):
+                t = off[0] ** 2 * ff * (g[k] + g[kj])
+                full += t
+                part += t * membrane_weight(g[k], g[kj], ref)
+    return full / part
+
+
+def membrane_member(base, dim: int, ref: float):
+    """``base`` with the ``--membrane`` pair (module docstring)."""
+    from crowndemo.core.state import FLUID, GONE
+    from crowndemo.core.surface_tension.stress import stress_pair_kernel, stress_times
+    ratio = membrane_ratio(dim, ref)
+
+    @ti.data_oriented
+    class MembraneStress(base):
+        @ti.func
+        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+            kind_j = self.state.kind[j]
+            if kind_j != GONE:
+                f = stress_times(self.colour[i], rij)
+                phi = 1.0
+                if kind_j == FLUID:
+                    f += stress_times(self.colour[j], rij)
+                    gi, gj = self.colour[i].norm(), self.colour[j].norm()
+                    phi = 0.0
+                    if ti.static(ref > 0.0):
+                        l0 = self.coef.l0[None]
+                        phi = ti.min(1.0, gi * l0 / ref) * ti.min(1.0, gj * l0 / ref)
+                    elif gi + gj > 0.0:
+                        phi = 2.0 * ti.min(gi, gj) / (gi + gj)
+                acc += ratio * phi * f * stress_pair_kernel(ti.sqrt(r2), self.coef.re[None],
+                                                            self.coef.l0[None])
+
+    return MembraneStress
 
 
 def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
@@ -233,7 +300,9 @@ def drop(dim: int, scale: float, t_ms: float, every_ms: float) -> None:
               f"  pull / Laplace pull {pull.sum() / (laplace * area):.3f}"
               f"  surface: {surf.sum()} particles, r / R {r[surf].mean() / R:.3f},"
               f" spacing / l0 {gap.min(axis=1).mean() / l0:.3f}, at P = 0 {(P[surf] <= 0).mean():.2f},"
-              f" pull share {pull[surf].sum() / pull.sum():.2f}  r_max / R {r.max() / R:.3f}",
+              f" P / Laplace {P[surf].mean() / laplace:.3f},"
+              f" pull share {pull[surf].sum() / pull.sum():.2f}  r_max / R {r.max() / R:.3f},"
+              f" pull's radius / R {(pull * r).sum() / pull.sum() / R:.3f}",
               flush=True)
 
 
@@ -255,9 +324,12 @@ def main() -> None:
     ap.add_argument("args", nargs="+")
     ap.add_argument("--surface", choices=("zero", "neighbours", "own"), default="zero")
     ap.add_argument("--own-factor", type=float, default=1.0)
+    ap.add_argument("--own-per-area", action="store_true")
     ap.add_argument("--core", type=float, default=None)
     ap.add_argument("--isotropic-core", action="store_true")
     ap.add_argument("--tangential-moment", action="store_true")
+    ap.add_argument("--membrane", action="store_true")
+    ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
@@ -271,12 +343,17 @@ def main() -> None:
     if a.tangential_moment:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim)
+    if a.membrane:
+        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+        member = membrane_member(member, dim, a.membrane_ref)
     if a.isotropic_core:
         member = isotropic_core_member(member)
     if a.surface == "neighbours":
         member = neighbours_pressure_member(member)
     elif a.surface == "own":
-        member = own_pressure_member(member, a.own_factor)
+        if a.own_per_area and not a.tangential_moment:
+            raise SystemExit("--own-per-area needs --tangential-moment")
+        member = own_pressure_member(member, a.own_factor, a.own_per_area)
     family.MODELS["stress"] = member
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every)
