@@ -1,9 +1,11 @@
 """The surface-stress member's resting-drop diagnostics of VALIDATION.md ("What the surface
 layer does", issue 23), reproducible:
 
-    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--surface neighbours|own]
-                          [--core X] [--isotropic-core] [--tangential-moment] [--every MS]
+    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS
+                          [--surface neighbours|virial|own] [--core X] [--isotropic-core]
+                          [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
+                          [--virial-moment] [--profile]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
@@ -11,12 +13,15 @@ inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension f
 Laplace pull ((d - 1) sigma / R times the drop's area), the surface layer (|g| l0 > 1/4): its
 size, mean radius, mean nearest-neighbour spacing, the share of it at P = 0, its mean pressure,
 the share of the pull it carries; the drop's largest radius and the pull's radius (the radius
-of each particle weighted by its radial tension force: where the pull acts). ``case``: one
+of each particle weighted by its radial tension force: where the pull acts), the virial's
+A_d/A and V_d/V (VALIDATION.md, "What sets the inside pressure") and the ratio of the pressure's
+virial to the tension's (1 at rest); ``--profile`` adds P n/n0 over P_in in shells. ``case``: one
 row of a stress-* validation case (validate/tension_cases.py).
 
 Experiments, not member options (VALIDATION.md says what each did):
 ``--surface neighbours``: free-surface particles (P = 0 after S17/M3) take the w-weighted mean
-pressure of their pressurised fluid neighbours before the stress passes;
+pressure of their pressurised fluid neighbours before the stress passes; ``--surface virial``:
+the same times n0/n_i (at most 3), so that P_i n_i/n0 is the neighbours' pressure;
 ``--surface own``: after the passes they take the normal stress their own tension carries,
 P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1); with
 ``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle holds;
@@ -27,6 +32,8 @@ instead of through the tangential projection, so a surface particle cannot sink 
 c_i = B0 / B_i, B_i = sum_j |g_j| l0 (|r_ij|^2 - (r_ij . n_i)^2) / l0^2 f_d(r_ij) over fluid j,
 the surface's tangential moment about i (packing raises it), B0 its value at a flat lattice
 face's outer particle; c in [1/4, 4]; a third pass, drops only.
+``--virial-moment``: the tangential moment's c_i from the unweighted moment, c_i = M0/M_i,
+M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat face's;
 ``--membrane``: each pair's stress (T_i + T_j) weighted by phi_ij = 2 min(|g_i|, |g_j|) /
 (|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
 the tension acts between surface particles only (an inner particle, g = 0, takes none of the
@@ -43,8 +50,9 @@ import taichi as ti
 from crowndemo import backend
 
 
-def neighbours_pressure_member(base):
-    """``base`` with the ``--surface neighbours`` pass (module docstring)."""
+def neighbours_pressure_member(base, scaled: bool = False):
+    """``base`` with the ``--surface neighbours`` pass (module docstring); ``scaled``: the
+    ``--surface virial`` one (times n0/n_i)."""
     from crowndemo.core.operators import weight
     from crowndemo.core.state import FLUID
 
@@ -76,6 +84,9 @@ def neighbours_pressure_member(base):
                                                  self._pressurised, acc)
                     if acc[1] > 0.0:
                         self.p_new[i] = acc[0] / acc[1]
+                        if ti.static(scaled):
+                            self.p_new[i] *= ti.min(
+                                self.coef.n0[None] / ti.max(self.state.density[i], 1e-30), 3.0)
 
         @ti.kernel
         def _commit(self):
@@ -214,11 +225,22 @@ def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
                      if 0 <= k < len(g)))
 
 
-def tangential_moment_member(base, beta: float, dim: int):
-    """``base`` with the ``--tangential-moment`` pass (module docstring)."""
-    from crowndemo.core.state import FLUID
+def lattice_virial_moment(dim: int, re_over_l0: float = 2.1) -> float:
+    """M0: the unweighted tangential moment sum_j r_t^2 f_d (``--virial-moment``) of an outer
+    particle of a flat lattice face, in l0^2."""
+    from crowndemo.core import lattice
+    offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
+    fd = lattice.stress_pair_kernel(np.linalg.norm(offs, axis=1), re_over_l0)
+    below = offs[:, -1] <= 1e-9
+    return float(((offs[below, :-1] ** 2).sum(axis=1) * fd[below]).sum())
+
+
+def tangential_moment_member(base, beta: float, dim: int, virial: bool = False):
+    """``base`` with the ``--tangential-moment`` pass (module docstring); ``virial``: the
+    ``--virial-moment`` one."""
+    from crowndemo.core.state import FLUID, GONE
     from crowndemo.core.surface_tension.stress import stress_pair_kernel
-    B0 = lattice_moment(dim, beta)
+    B0 = lattice_virial_moment(dim) if virial else lattice_moment(dim, beta)
 
     @ti.data_oriented
     class TangentialMomentStress(base):
@@ -236,11 +258,15 @@ def tangential_moment_member(base, beta: float, dim: int):
 
         @ti.func
         def _moment_pair(self, i, j, rij, r2, acc: ti.template()):
-            if self.state.kind[j] == FLUID:
-                l0 = self.coef.l0[None]
-                n = self.colour[i].normalized()
-                acc += self.colour[j].norm() * l0 * (r2 - rij.dot(n) ** 2) / (l0 * l0) * (
-                    stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0))
+            l0 = self.coef.l0[None]
+            n = self.colour[i].normalized()
+            moment = (r2 - rij.dot(n) ** 2) / (l0 * l0) * (
+                stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0))
+            if ti.static(virial):
+                if self.state.kind[j] != GONE:
+                    acc += moment
+            elif self.state.kind[j] == FLUID:
+                acc += self.colour[j].norm() * l0 * moment
 
         @ti.kernel
         def _moment(self):
@@ -264,7 +290,7 @@ def tangential_moment_member(base, beta: float, dim: int):
     return TangentialMomentStress
 
 
-def drop(dim: int, scale: float, t_ms: float, every_ms: float) -> None:
+def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = False) -> None:
     from crowndemo.core.params import Numerics
     from crowndemo.scenes.drop import resting_drop
     from crowndemo.validate.cases import simulator
@@ -293,17 +319,36 @@ def drop(dim: int, scale: float, t_ms: float, every_ms: float) -> None:
         r = np.linalg.norm(d, axis=1)
         pull = -(acc * d / r[:, None]).sum(axis=1) * rho * l0 ** dim
         surf = g > 0.25
+        nd = sim.state.density.to_numpy()[:n] / sim.coef.n0[None]
+        P_in = P[r < R / 2].mean()
+        tension_virial = -(acc * d).sum() * rho * l0 ** dim          # -sum_i r_i . F_i
+        area_d = tension_virial / ((dim - 1) * sigma * area)          # A_d / A
+        volume_d = (P * nd).sum() / (P_in * n)                        # V_d / V
         ps = pos[surf]
         gap = np.linalg.norm(ps[:, None] - ps[None], axis=2)
         np.fill_diagonal(gap, np.inf)
-        print(f"t = {sim.stats.time * 1e3:5.2f} ms  P_in / Laplace {P[r < R / 2].mean() / laplace:.3f}"
+        print(f"t = {sim.stats.time * 1e3:5.2f} ms  P_in / Laplace {P_in / laplace:.3f}"
               f"  pull / Laplace pull {pull.sum() / (laplace * area):.3f}"
               f"  surface: {surf.sum()} particles, r / R {r[surf].mean() / R:.3f},"
-              f" spacing / l0 {gap.min(axis=1).mean() / l0:.3f}, at P = 0 {(P[surf] <= 0).mean():.2f},"
+              f" spacing / l0 {gap.min(axis=1).mean() / l0:.3f},"
+              f" at P = 0 {(P[surf] <= 0).mean():.2f},"
               f" P / Laplace {P[surf].mean() / laplace:.3f},"
               f" pull share {pull[surf].sum() / pull.sum():.2f}  r_max / R {r.max() / R:.3f},"
-              f" pull's radius / R {(pull * r).sum() / pull.sum() / R:.3f}",
+              f" pull's radius / R {(pull * r).sum() / pull.sum() / R:.3f},"
+              f" virial: A_d/A {area_d:.3f} V_d/V {volume_d:.3f}"
+              f" pressure/tension {dim * (P * nd).sum() * l0 ** dim / tension_virial:.3f}",
               flush=True)
+        if profile:
+            edges = R - l0 * np.arange(0.0, 4.01, 0.5)[::-1] - 0.25 * l0
+            edges = np.append(edges, 2 * R)
+            rows = []
+            for lo, hi in zip(edges[:-1], edges[1:]):
+                m = (r >= lo) & (r < hi)
+                if m.any():
+                    share = (P[m] * nd[m]).mean() / P_in
+                    rows.append(f"{(lo - R) / l0:+.2f}: {m.sum()} x {share:.2f}"
+                                f" (n/n0 {nd[m].mean():.2f})")
+            print("   P n/n0 / P_in by (r - R)/l0 from: " + "; ".join(rows), flush=True)
 
 
 def case(name: str, scales: str) -> None:
@@ -322,16 +367,20 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("what", choices=("drop", "case"))
     ap.add_argument("args", nargs="+")
-    ap.add_argument("--surface", choices=("zero", "neighbours", "own"), default="zero")
+    ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own"),
+                    default="zero")
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--own-per-area", action="store_true")
     ap.add_argument("--core", type=float, default=None)
     ap.add_argument("--isotropic-core", action="store_true")
     ap.add_argument("--tangential-moment", action="store_true")
+    ap.add_argument("--virial-moment", action="store_true")
     ap.add_argument("--membrane", action="store_true")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--profile", action="store_true",
+                    help="drop: P n/n0 over the inside pressure in shells l0/2 thick")
     a = ap.parse_args()
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
@@ -340,23 +389,24 @@ def main() -> None:
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     member = stress.StressTension
-    if a.tangential_moment:
+    if a.tangential_moment or a.virial_moment:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
-        member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim)
+        member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
+                                          virial=a.virial_moment)
     if a.membrane:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = membrane_member(member, dim, a.membrane_ref)
     if a.isotropic_core:
         member = isotropic_core_member(member)
-    if a.surface == "neighbours":
-        member = neighbours_pressure_member(member)
+    if a.surface in ("neighbours", "virial"):
+        member = neighbours_pressure_member(member, scaled=a.surface == "virial")
     elif a.surface == "own":
         if a.own_per_area and not a.tangential_moment:
             raise SystemExit("--own-per-area needs --tangential-moment")
         member = own_pressure_member(member, a.own_factor, a.own_per_area)
     family.MODELS["stress"] = member
     if a.what == "drop":
-        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every)
+        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
     else:
         case(a.args[0], a.args[1])
 
