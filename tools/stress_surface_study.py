@@ -31,7 +31,8 @@ instead of through the tangential projection, so a surface particle cannot sink 
 ``--tangential-moment``: after pass 1 each surface particle's g (so its tension) is scaled by
 c_i = B0 / B_i, B_i = sum_j |g_j| l0 (|r_ij|^2 - (r_ij . n_i)^2) / l0^2 f_d(r_ij) over fluid j,
 the surface's tangential moment about i (packing raises it), B0 its value at a flat lattice
-face's outer particle; c in [1/4, 4]; a third pass, drops only.
+face's outer particle; c in [1/X, X], X = ``--moment-clamp`` (default 4); a third pass,
+drops only.
 ``--virial-moment``: the tangential moment's c_i from the unweighted moment, c_i = M0/M_i,
 M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat face's;
 ``--membrane``: each pair's stress (T_i + T_j) weighted by phi_ij = 2 min(|g_i|, |g_j|) /
@@ -235,7 +236,8 @@ def lattice_virial_moment(dim: int, re_over_l0: float = 2.1) -> float:
     return float(((offs[below, :-1] ** 2).sum(axis=1) * fd[below]).sum())
 
 
-def tangential_moment_member(base, beta: float, dim: int, virial: bool = False):
+def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
+                             clamp: float = 4.0):
     """``base`` with the ``--tangential-moment`` pass (module docstring); ``virial``: the
     ``--virial-moment`` one."""
     from crowndemo.core.state import FLUID, GONE
@@ -278,7 +280,7 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False):
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._moment_pair, b)
                     if b > 0.0:
-                        c = ti.min(ti.max(B0 / b, 0.25), 4.0)
+                        c = ti.min(ti.max(B0 / b, 1.0 / clamp), clamp)
                 self.share[i] = c
 
         @ti.kernel
@@ -375,6 +377,7 @@ def main() -> None:
     ap.add_argument("--isotropic-core", action="store_true")
     ap.add_argument("--tangential-moment", action="store_true")
     ap.add_argument("--virial-moment", action="store_true")
+    ap.add_argument("--moment-clamp", type=float, default=4.0)
     ap.add_argument("--membrane", action="store_true")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
@@ -392,7 +395,7 @@ def main() -> None:
     if a.tangential_moment or a.virial_moment:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
-                                          virial=a.virial_moment)
+                                          virial=a.virial_moment, clamp=a.moment_clamp)
     if a.membrane:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = membrane_member(member, dim, a.membrane_ref)
