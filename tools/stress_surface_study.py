@@ -7,6 +7,7 @@ layer does", issue 23), reproducible:
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--profile]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
+    .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
 inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
@@ -16,7 +17,9 @@ the share of the pull it carries; the drop's largest radius and the pull's radiu
 of each particle weighted by its radial tension force: where the pull acts), the virial's
 A_d/A and V_d/V (VALIDATION.md, "What sets the inside pressure") and the ratio of the pressure's
 virial to the tension's (1 at rest); ``--profile`` adds P n/n0 over P_in in shells. ``case``: one
-row of a stress-* validation case (validate/tension_cases.py).
+row of a stress-* validation case (validate/tension_cases.py). ``stretch``: the tension a flat
+2D surface carries by the member's formulas when its outer layer's spacing is S l0, alone and
+with the tangential moment (``flat_tension``; numpy, no Taichi).
 
 Experiments, not member options (VALIDATION.md says what each did):
 ``--surface neighbours``: free-surface particles (P = 0 after S17/M3) take the w-weighted mean
@@ -39,6 +42,9 @@ M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat
 (|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
 the tension acts between surface particles only (an inner particle, g = 0, takes none of the
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
+``--pair-kernel smooth``: the divergence's pair weight f_d = (1 - (r/re)^4)^2 (zero slope
+at re) in place of the member's 1 - (r/re)^4, its K_d and a from the lattice
+(pair_normalisers); the tangential moment follows it.
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
@@ -49,6 +55,7 @@ import numpy as np
 import taichi as ti
 
 from crowndemo import backend
+from crowndemo.core.surface_tension import stress as _stress
 
 
 def neighbours_pressure_member(base, scaled: bool = False):
@@ -206,7 +213,8 @@ def membrane_member(base, dim: int, ref: float):
     return MembraneStress
 
 
-def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
+def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1,
+                   kernel: str = "quartic") -> float:
     """B0: the tangential moment (``tangential_moment_member``) of an outer particle of a flat
     lattice face, from the lattice's colour column (lattice.colour_gradient_column) times
     omega of each layer (C1)."""
@@ -219,7 +227,7 @@ def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1) -> float:
     for k, gk in enumerate(column):
         n_k = w[offs[:, -1] <= k + 1e-9].sum() / w.sum()      # layer k's number density
         g.append(gk * min(max((1.0 - n_k) / (2.0 * (1.0 - beta)), 0.0), 1.0))
-    fd = lattice.stress_pair_kernel(r, re_over_l0)
+    fd = pair_kernel(kernel)(r, re_over_l0)
     layer = np.round(-offs[:, -1]).astype(int)                  # j's layer, i in layer 0
     tangential = (offs[:, :-1] ** 2).sum(axis=1)
     return float(sum(g[k] * t * f for k, t, f in zip(layer, tangential, fd)
@@ -237,12 +245,14 @@ def lattice_virial_moment(dim: int, re_over_l0: float = 2.1) -> float:
 
 
 def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
-                             clamp: float = 4.0):
+                             clamp: float = 4.0, kernel: str = "quartic"):
     """``base`` with the ``--tangential-moment`` pass (module docstring); ``virial``: the
     ``--virial-moment`` one."""
     from crowndemo.core.state import FLUID, GONE
     from crowndemo.core.surface_tension.stress import stress_pair_kernel
-    B0 = lattice_virial_moment(dim) if virial else lattice_moment(dim, beta)
+    if virial and kernel != "quartic":
+        raise SystemExit("--virial-moment: with the member's pair kernel only")
+    B0 = lattice_virial_moment(dim) if virial else lattice_moment(dim, beta, kernel=kernel)
 
     @ti.data_oriented
     class TangentialMomentStress(base):
@@ -262,8 +272,12 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
         def _moment_pair(self, i, j, rij, r2, acc: ti.template()):
             l0 = self.coef.l0[None]
             n = self.colour[i].normalized()
-            moment = (r2 - rij.dot(n) ** 2) / (l0 * l0) * (
-                stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0))
+            fd = 0.0
+            if ti.static(kernel == "smooth"):
+                fd = smooth_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
+            else:
+                fd = stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
+            moment = (r2 - rij.dot(n) ** 2) / (l0 * l0) * fd
             if ti.static(virial):
                 if self.state.kind[j] != GONE:
                     acc += moment
@@ -353,6 +367,139 @@ def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = F
             print("   P n/n0 / P_in by (r - R)/l0 from: " + "; ".join(rows), flush=True)
 
 
+PAIR_KERNELS = {      # f_d(q), q = r/re, for --pair-kernel (the member's is "quartic", C3)
+    "quartic": lambda q: 1.0 - q ** 4,
+    "smooth": lambda q: (1.0 - q ** 4) ** 2,       # zero slope at re
+}
+
+
+def pair_kernel(name: str):
+    """f_d(r, re) of PAIR_KERNELS[name], 0 beyond re (no core: as lattice.stress_pair_kernel)."""
+    def f(r, re):
+        r = np.asarray(r, dtype=float)
+        return np.where(r < re, PAIR_KERNELS[name](np.minimum(r, re) / re), 0.0)
+    return f
+
+
+def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
+    """(K_d, a) for the pair kernel ``name`` in units of l0 = 1, as lattice.stress_gradient_norm
+    and lattice.stress_normaliser compute them for the member's."""
+    from crowndemo.core import lattice
+    kernel = pair_kernel(name)
+    Kd = lattice.stress_gradient_norm(dim, 1.0, re, kernel)
+    offs = lattice.lattice_offsets(dim, 1.0, re)
+    f = kernel(np.linalg.norm(offs, axis=1), re)
+    g = lattice.colour_gradient_column(dim, 1.0, re)
+    total = 0.0
+    for k in range(len(g)):
+        for off, ff in zip(offs, f):
+            kj = k - int(round(off[-1]))
+            if off[0] > 0 and kj >= 0:
+                total += off[0] ** 2 * ff * (g[k] + (g[kj] if kj < len(g) else 0.0))
+    return Kd, 1.0 / (Kd * total)
+
+
+@ti.func
+def smooth_pair_kernel(r, re, l0):
+    """f_d = (1 - (r/re)^4)^2 (``--pair-kernel smooth``), times the member's core below l0."""
+    q = r / re
+    f = 1.0 - q * q * q * q
+    f *= f
+    if r < l0:
+        f *= (r / l0 - _stress.CORE) / (1.0 - _stress.CORE)
+    return f
+
+
+def smooth_kernel_member(base, dim: int):
+    """``base`` with ``--pair-kernel smooth``: f_d = (1 - (r/re)^4)^2 (the core below l0 as the
+    member's), its K_d and a from the lattice (pair_normalisers) in place of the member's."""
+    from crowndemo.core import lattice
+    from crowndemo.core.state import FLUID, GONE
+    from crowndemo.core.surface_tension import stress
+    Kd, a = pair_normalisers(dim, "smooth")
+    ratio = Kd * a / (lattice.stress_gradient_norm(dim, 1.0, 2.1, lattice.stress_pair_kernel)
+                      * lattice.stress_normaliser(dim, 1.0, 2.1))
+
+    @ti.data_oriented
+    class SmoothKernelStress(base):
+        @ti.func
+        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+            kind_j = self.state.kind[j]
+            if kind_j != GONE:
+                f = stress.stress_times(self.colour[i], rij)
+                if kind_j == FLUID:
+                    f += stress.stress_times(self.colour[j], rij)
+                acc += ratio * f * smooth_pair_kernel(ti.sqrt(r2), self.coef.re[None],
+                                                      self.coef.l0[None])
+
+    return SmoothKernelStress
+
+
+def _strip(s: float, beta: float, re: float, width: int, kernel: str):
+    """``flat_tension``'s strip: positions p, r_ij = p_j - p_i (d), |r_ij|, |g|, unit g, f_d."""
+    from crowndemo.core import lattice
+    K = lattice.stress_gradient_norm(2, 1.0, re)
+    n0 = lattice.weight(np.linalg.norm(lattice.lattice_offsets(2, 1.0, re), axis=1), re).sum()
+    outer = [(i * s, 0.0) for i in range(-int(width / s), int(width / s) + 1)]
+    below = [(float(i), -float(k)) for k in range(1, 8) for i in range(-width, width + 1)]
+    p = np.array(outer + below)
+    d = p[None] - p[:, None]
+    r = np.linalg.norm(d, axis=2)
+    np.fill_diagonal(r, np.inf)
+    n = np.where(r < re, re / r - 1.0, 0.0).sum(axis=1)       # number density (S1)
+    g = K * (d * np.where(r < re, (1.0 - r / re) ** 3, 0.0)[..., None]).sum(axis=1)   # C1
+    g *= np.clip((1.0 - n / n0) / (2.0 * (1.0 - beta)), 0.0, 1.0)[:, None]
+    gn = np.linalg.norm(g, axis=1)
+    unit = g / np.maximum(gn, 1e-30)[:, None]
+    fd = pair_kernel(kernel)(r, re)
+    fd = np.where(r < 1.0, fd * (np.minimum(r, 1.0) - 0.75) / 0.25, fd)            # the core
+    return p, d, r, gn, unit, fd
+
+
+def _strip_moment(d, r, gn, unit, fd):
+    """The tangential moment B_i = sum_j |g_j| r_t^2 f_d of every strip particle."""
+    rt2 = np.where(np.isfinite(r), r, 0.0) ** 2 - (d * unit[:, None]).sum(axis=2) ** 2
+    return (gn[None] * rt2 * fd).sum(axis=1)
+
+
+def flat_tension(s: float, beta: float, re: float = 2.1, width: int = 60,
+                 moment_power: float = 0.0, kernel: str = "quartic") -> float:
+    """The tension a flat 2D lattice surface transmits when its outer layer's in-plane spacing
+    is s l0 (the layers below on the lattice), by the member's C1-C3 (core included) with the
+    pair kernel ``kernel``, over sigma: the x force of the pairs across a vertical cut, averaged
+    over cut positions, in a strip 2 width l0 long and 8 layers deep (the top four counted, away
+    from the bottom's own surface). ``moment_power`` p: each g scaled by c^p, c = B0/B the
+    tangential moment's (``--tangential-moment``; B0 the outer particle's at s = 1). numpy
+    only; l0 = 1."""
+    Kd, a = pair_normalisers(2, kernel, re)
+    p, d, r, gn, unit, fd = _strip(s, beta, re, width, kernel)
+    if moment_power:
+        q, dq, rq, gq, uq, fq = _strip(1.0, beta, re, width, kernel)
+        B0 = _strip_moment(dq, rq, gq, uq, fq)[np.argmin(np.abs(q).sum(axis=1))]
+        B = _strip_moment(d, r, gn, unit, fd)
+        c = np.where(B > 0, np.clip(B0 / np.maximum(B, 1e-30), 0.25, 4.0), 1.0)
+        gn = gn * c ** moment_power
+    top, mid = p[:, 1] > -3.5, np.abs(p[:, 0]) < width / 3
+    forces = []
+    for c in np.linspace(-3.0, 3.0, 240, endpoint=False) + 0.01234:
+        L = np.flatnonzero(top & mid & (p[:, 0] < c))
+        Rr = np.flatnonzero(top & (np.abs(p[:, 0]) < width / 2) & (p[:, 0] > c))
+        rij = d[np.ix_(L, Rr)]
+        Ti = gn[L][:, None, None] * (rij - unit[L][:, None] * (unit[L][:, None] * rij).sum(
+            axis=-1, keepdims=True))
+        Tj = gn[Rr][None, :, None] * (rij - unit[Rr][None] * (unit[Rr][None] * rij).sum(
+            axis=-1, keepdims=True))
+        forces.append(a * Kd * (((Ti + Tj)[..., 0]) * fd[np.ix_(L, Rr)]).sum())
+    return float(np.mean(forces))
+
+
+def stretch(spacings: str, beta: float, kernel: str) -> None:
+    for s in spacings.split(","):
+        t = [flat_tension(float(s), beta, moment_power=q, kernel=kernel) for q in (0.0, 1.0, 2.0)]
+        print(f"outer layer at {float(s):.2f} l0: tension / sigma {t[0]:.3f}; with the moment"
+              f" (g c) {t[1]:.3f}, (g c^2) {t[2]:.3f}", flush=True)
+
+
 def case(name: str, scales: str) -> None:
     from crowndemo.core import Numerics
     from crowndemo.validate.tension_cases import tension_cases
@@ -367,7 +514,7 @@ def case(name: str, scales: str) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("what", choices=("drop", "case"))
+    ap.add_argument("what", choices=("drop", "case", "stretch"))
     ap.add_argument("args", nargs="+")
     ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own"),
                     default="zero")
@@ -378,6 +525,7 @@ def main() -> None:
     ap.add_argument("--tangential-moment", action="store_true")
     ap.add_argument("--virial-moment", action="store_true")
     ap.add_argument("--moment-clamp", type=float, default=4.0)
+    ap.add_argument("--pair-kernel", choices=tuple(PAIR_KERNELS), default="quartic")
     ap.add_argument("--membrane", action="store_true")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
@@ -385,6 +533,10 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true",
                     help="drop: P n/n0 over the inside pressure in shells l0/2 thick")
     a = ap.parse_args()
+    if a.what == "stretch":
+        from crowndemo.core import Numerics
+        stretch(a.args[0], Numerics().free_surface_beta(2), a.pair_kernel)
+        return
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
     import crowndemo.core.surface_tension.stress as stress
@@ -395,7 +547,13 @@ def main() -> None:
     if a.tangential_moment or a.virial_moment:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
-                                          virial=a.virial_moment, clamp=a.moment_clamp)
+                                          virial=a.virial_moment, clamp=a.moment_clamp,
+                                          kernel=a.pair_kernel)
+    if a.pair_kernel == "smooth":
+        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+        if a.membrane or a.isotropic_core:
+            raise SystemExit("--pair-kernel smooth: not with --membrane or --isotropic-core")
+        member = smooth_kernel_member(member, dim)
     if a.membrane:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = membrane_member(member, dim, a.membrane_ref)
