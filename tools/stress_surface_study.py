@@ -2,7 +2,7 @@
 layer does", issue 23), reproducible:
 
     .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS
-                          [--surface neighbours|virial|own] [--core X] [--isotropic-core]
+                          [--surface neighbours|virial|own|blend] [--core X] [--isotropic-core]
                           [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--profile]
@@ -28,6 +28,7 @@ the same times n0/n_i (at most 3), so that P_i n_i/n0 is the neighbours' pressur
 ``--surface own``: after the passes they take the normal stress their own tension carries,
 P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1); with
 ``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle holds;
+``--surface blend``: the smaller of the two (neighbours' mean, own normal stress);
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -129,6 +130,46 @@ def own_pressure_member(base, factor: float, per_area: bool = False):
                         ti.max(inward, 0.0))
 
     return OwnPressureStress
+
+
+def blend_pressure_member(base):
+    """``base`` with ``--surface blend``: a free-surface particle (P = 0 after S17/M3) takes the
+    smaller of its pressurised neighbours' mean (``--surface neighbours``) and the normal stress
+    its own tension carries (``--surface own``, F = 1)."""
+    from crowndemo.core.state import FLUID
+    member = neighbours_pressure_member(base)
+
+    @ti.data_oriented
+    class BlendPressureStress(member):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.free = ti.field(ti.i32, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._mark()
+            super().boundary_pressure()
+            self._blend()
+
+        @ti.kernel
+        def _mark(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.free[i] = 1 if (self.state.kind[i] == FLUID
+                                     and self.state.pressure[i] <= 0.0) else 0
+
+        @ti.kernel
+        def _blend(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                g = self.colour[i]
+                if self.free[i] == 1:
+                    own = 0.0
+                    if g.norm() > 0.0:
+                        own = self.coef.rho[None] * self.coef.l0[None] * ti.max(
+                            self.accel[i].dot(g) / g.norm(), 0.0)
+                    self.state.pressure[i] = ti.min(self.state.pressure[i], own)
+
+    return BlendPressureStress
 
 
 def isotropic_core_member(base):
@@ -516,7 +557,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("what", choices=("drop", "case", "stretch"))
     ap.add_argument("args", nargs="+")
-    ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own"),
+    ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own", "blend"),
                     default="zero")
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--own-per-area", action="store_true")
@@ -559,7 +600,9 @@ def main() -> None:
         member = membrane_member(member, dim, a.membrane_ref)
     if a.isotropic_core:
         member = isotropic_core_member(member)
-    if a.surface in ("neighbours", "virial"):
+    if a.surface == "blend":
+        member = blend_pressure_member(member)
+    elif a.surface in ("neighbours", "virial"):
         member = neighbours_pressure_member(member, scaled=a.surface == "virial")
     elif a.surface == "own":
         if a.own_per_area and not a.tangential_moment:
