@@ -45,7 +45,8 @@ the tension acts between surface particles only (an inner particle, g = 0, takes
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
 ``--pair-kernel smooth``: the divergence's pair weight f_d = (1 - (r/re)^4)^2 (zero slope
 at re) in place of the member's 1 - (r/re)^4, its K_d and a from the lattice
-(pair_normalisers); the tangential moment follows it.
+(pair_normalisers); the tangential moment follows it. ``smooth2`` (the same with support
+2 l0; not with the moments).
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
@@ -408,17 +409,21 @@ def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = F
             print("   P n/n0 / P_in by (r - R)/l0 from: " + "; ".join(rows), flush=True)
 
 
-PAIR_KERNELS = {      # f_d(q), q = r/re, for --pair-kernel (the member's is "quartic", C3)
+PAIR_KERNELS = {      # f_d(q), q = r/support, for --pair-kernel (the member's is "quartic", C3)
     "quartic": lambda q: 1.0 - q ** 4,
-    "smooth": lambda q: (1.0 - q ** 4) ** 2,       # zero slope at re
+    "smooth": lambda q: (1.0 - q ** 4) ** 2,       # zero slope at the support's edge
+    "smooth2": lambda q: (1.0 - q ** 4) ** 2,      # the same, its support 2 l0
 }
+PAIR_SUPPORT = {"smooth2": 2.0 / 2.1}              # support / re where it is not re
 
 
 def pair_kernel(name: str):
-    """f_d(r, re) of PAIR_KERNELS[name], 0 beyond re (no core: as lattice.stress_pair_kernel)."""
+    """f_d(r, re) of PAIR_KERNELS[name], 0 beyond its support (re times PAIR_SUPPORT; no core:
+    as lattice.stress_pair_kernel)."""
     def f(r, re):
+        h = re * PAIR_SUPPORT.get(name, 1.0)
         r = np.asarray(r, dtype=float)
-        return np.where(r < re, PAIR_KERNELS[name](np.minimum(r, re) / re), 0.0)
+        return np.where(r < h, PAIR_KERNELS[name](np.minimum(r, h) / h), 0.0)
     return f
 
 
@@ -443,7 +448,7 @@ def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
 @ti.func
 def smooth_pair_kernel(r, re, l0):
     """f_d = (1 - (r/re)^4)^2 (``--pair-kernel smooth``), times the member's core below l0."""
-    q = r / re
+    q = ti.min(r / re, 1.0)
     f = 1.0 - q * q * q * q
     f *= f
     if r < l0:
@@ -451,13 +456,15 @@ def smooth_pair_kernel(r, re, l0):
     return f
 
 
-def smooth_kernel_member(base, dim: int):
-    """``base`` with ``--pair-kernel smooth``: f_d = (1 - (r/re)^4)^2 (the core below l0 as the
-    member's), its K_d and a from the lattice (pair_normalisers) in place of the member's."""
+def smooth_kernel_member(base, dim: int, name: str = "smooth"):
+    """``base`` with ``--pair-kernel smooth`` (or ``smooth2``): f_d = (1 - (r/h)^4)^2, h = re
+    (2 l0), the core below l0 as the member's, its K_d and a from the lattice
+    (pair_normalisers) in place of the member's."""
     from crowndemo.core import lattice
     from crowndemo.core.state import FLUID, GONE
     from crowndemo.core.surface_tension import stress
-    Kd, a = pair_normalisers(dim, "smooth")
+    Kd, a = pair_normalisers(dim, name)
+    h = PAIR_SUPPORT.get(name, 1.0)
     ratio = Kd * a / (lattice.stress_gradient_norm(dim, 1.0, 2.1, lattice.stress_pair_kernel)
                       * lattice.stress_normaliser(dim, 1.0, 2.1))
 
@@ -470,7 +477,7 @@ def smooth_kernel_member(base, dim: int):
                 f = stress.stress_times(self.colour[i], rij)
                 if kind_j == FLUID:
                     f += stress.stress_times(self.colour[j], rij)
-                acc += ratio * f * smooth_pair_kernel(ti.sqrt(r2), self.coef.re[None],
+                acc += ratio * f * smooth_pair_kernel(ti.sqrt(r2), h * self.coef.re[None],
                                                       self.coef.l0[None])
 
     return SmoothKernelStress
@@ -590,11 +597,13 @@ def main() -> None:
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
                                           virial=a.virial_moment, clamp=a.moment_clamp,
                                           kernel=a.pair_kernel)
-    if a.pair_kernel == "smooth":
+    if a.pair_kernel == "smooth2" and (a.tangential_moment or a.virial_moment):
+        raise SystemExit("--pair-kernel smooth2: not with the moments")
+    if a.pair_kernel in ("smooth", "smooth2"):
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         if a.membrane or a.isotropic_core:
             raise SystemExit("--pair-kernel smooth: not with --membrane or --isotropic-core")
-        member = smooth_kernel_member(member, dim)
+        member = smooth_kernel_member(member, dim, a.pair_kernel)
     if a.membrane:
         dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = membrane_member(member, dim, a.membrane_ref)
