@@ -46,7 +46,8 @@ pull), a rescaled so that a flat lattice face still carries sigma (membrane_rati
 ``--pair-kernel smooth``: the divergence's pair weight f_d = (1 - (r/re)^4)^2 (zero slope
 at re) in place of the member's 1 - (r/re)^4, its K_d and a from the lattice
 (pair_normalisers); the tangential moment follows it. ``smooth2`` (the same with support
-2 l0; not with the moments).
+2 l0; not with the moments); ``smooth25`` and ``smooth3`` (supports 2.5 and 3 l0) for
+``stretch`` only.
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
@@ -413,8 +414,10 @@ PAIR_KERNELS = {      # f_d(q), q = r/support, for --pair-kernel (the member's i
     "quartic": lambda q: 1.0 - q ** 4,
     "smooth": lambda q: (1.0 - q ** 4) ** 2,       # zero slope at the support's edge
     "smooth2": lambda q: (1.0 - q ** 4) ** 2,      # the same, its support 2 l0
+    "smooth25": lambda q: (1.0 - q ** 4) ** 2,     # support 2.5 l0 (stretch only: beyond r*)
+    "smooth3": lambda q: (1.0 - q ** 4) ** 2,      # support 3 l0 (stretch only)
 }
-PAIR_SUPPORT = {"smooth2": 2.0 / 2.1}              # support / re where it is not re
+PAIR_SUPPORT = {"smooth2": 2.0 / 2.1, "smooth25": 2.5 / 2.1, "smooth3": 3.0 / 2.1}
 
 
 def pair_kernel(name: str):
@@ -432,8 +435,10 @@ def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
     and lattice.stress_normaliser compute them for the member's."""
     from crowndemo.core import lattice
     kernel = pair_kernel(name)
-    Kd = lattice.stress_gradient_norm(dim, 1.0, re, kernel)
-    offs = lattice.lattice_offsets(dim, 1.0, re)
+    reach = re * max(PAIR_SUPPORT.get(name, 1.0), 1.0)
+    offs = lattice.lattice_offsets(dim, 1.0, reach)
+    Kd = dim / float((np.linalg.norm(offs, axis=1) ** 2
+                      * kernel(np.linalg.norm(offs, axis=1), re)).sum())
     f = kernel(np.linalg.norm(offs, axis=1), re)
     g = lattice.colour_gradient_column(dim, 1.0, re)
     total = 0.0
@@ -597,6 +602,9 @@ def main() -> None:
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
                                           virial=a.virial_moment, clamp=a.moment_clamp,
                                           kernel=a.pair_kernel)
+    if PAIR_SUPPORT.get(a.pair_kernel, 1.0) > 1.0:
+        raise SystemExit(f"--pair-kernel {a.pair_kernel}: stretch only (its support is beyond "
+                         "the walk's r*)")
     if a.pair_kernel == "smooth2" and (a.tangential_moment or a.virial_moment):
         raise SystemExit("--pair-kernel smooth2: not with the moments")
     if a.pair_kernel in ("smooth", "smooth2"):
