@@ -210,8 +210,8 @@ def membrane_weight(gi, gj, ref):
 
 def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1) -> float:
     """a_membrane / a: the flat lattice face's normaliser a (lattice.stress_normaliser) with
-    each pair's stress weighted by phi_ij = 2 min(|g_i|, |g_j|) / (|g_i| + |g_j|)
-    (``membrane_member``), over the member's a."""
+    each pair's stress weighted by phi_ij (``membrane_weight``, ``membrane_member``), over the
+    member's a."""
     from crowndemo.core import lattice
     offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
     f = lattice.stress_pair_kernel(np.linalg.norm(offs, axis=1), re_over_l0)
