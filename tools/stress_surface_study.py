@@ -2,7 +2,8 @@
 layer does", issue 23), reproducible:
 
     .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS
-                          [--surface neighbours|virial|own|blend] [--core X] [--isotropic-core]
+                          [--surface neighbours|virial|own|own-spacing|blend] [--core X]
+                          [--isotropic-core]
                           [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--profile]
@@ -28,6 +29,8 @@ the same times n0/n_i (at most 3), so that P_i n_i/n0 is the neighbours' pressur
 ``--surface own``: after the passes they take the normal stress their own tension carries,
 P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1); with
 ``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle holds;
+``--surface own-spacing``: the own normal stress times (l0/s_i)^(d-1), s_i i's nearest
+neighbour along the surface (own_pressure_member);
 ``--surface blend``: the smaller of the two (neighbours' mean, own normal stress);
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
@@ -108,9 +111,12 @@ def neighbours_pressure_member(base, scaled: bool = False):
     return NeighbourPressureStress
 
 
-def own_pressure_member(base, factor: float, per_area: bool = False):
+def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bool = False):
     """``base`` with the ``--surface own`` pass (module docstring); ``per_area``: divided by
-    the tangential moment's c_i (the area a surface particle holds, over l0^2)."""
+    the tangential moment's c_i (the area a surface particle holds, over l0^2); ``spacing``
+    (``--surface own-spacing``): times (l0 / s_i)^(d-1), s_i the distance to i's nearest
+    fluid neighbour along its surface (|r_ij . n_i| < |r_ij| / 2): the force over the area the
+    particle holds, so a stretched layer's pressure falls and a packed one's rises."""
     from crowndemo.core.state import FLUID
 
     @ti.data_oriented
@@ -118,6 +124,13 @@ def own_pressure_member(base, factor: float, per_area: bool = False):
         def boundary_pressure(self) -> None:
             super().boundary_pressure()
             self._own_pressure()
+
+        @ti.func
+        def _nearest_along(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] == FLUID:
+                n = self.colour[i].normalized()
+                if ti.abs(rij.dot(n)) < 0.5 * ti.sqrt(r2):
+                    acc = ti.min(acc, ti.sqrt(r2))
 
         @ti.kernel
         def _own_pressure(self):
@@ -128,6 +141,13 @@ def own_pressure_member(base, factor: float, per_area: bool = False):
                     inward = self.accel[i].dot(g) / g.norm()
                     if ti.static(per_area):
                         inward /= self.share[i]
+                    if ti.static(spacing):
+                        l0 = self.coef.l0[None]
+                        near = 2.0 * l0
+                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                     self._nearest_along, near)
+                        inward *= (l0 / ti.min(ti.max(near, 0.5 * l0), 2.0 * l0)) ** (
+                            self.dim - 1)
                     self.state.pressure[i] = factor * self.coef.rho[None] * self.coef.l0[None] * (
                         ti.max(inward, 0.0))
 
@@ -569,7 +589,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("what", choices=("drop", "case", "stretch"))
     ap.add_argument("args", nargs="+")
-    ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own", "blend"),
+    ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own", "own-spacing",
+                                          "blend"),
                     default="zero")
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--own-per-area", action="store_true")
@@ -621,10 +642,11 @@ def main() -> None:
         member = blend_pressure_member(member)
     elif a.surface in ("neighbours", "virial"):
         member = neighbours_pressure_member(member, scaled=a.surface == "virial")
-    elif a.surface == "own":
+    elif a.surface in ("own", "own-spacing"):
         if a.own_per_area and not a.tangential_moment:
             raise SystemExit("--own-per-area needs --tangential-moment")
-        member = own_pressure_member(member, a.own_factor, a.own_per_area)
+        member = own_pressure_member(member, a.own_factor, a.own_per_area,
+                                     spacing=a.surface == "own-spacing")
     family.MODELS["stress"] = member
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
