@@ -54,6 +54,7 @@ at re) in place of the member's 1 - (r/re)^4, its K_d and a from the lattice
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
+import functools
 import math
 import time
 
@@ -111,6 +112,16 @@ def neighbours_pressure_member(base, scaled: bool = False):
     return NeighbourPressureStress
 
 
+@ti.func
+def own_normal_stress(rho, l0, a, g):
+    """rho l0 max(0, a . g/|g|): the normal stress a surface particle's own tension a carries
+    per area l0^(d-1) (``--surface own``); 0 where g = 0."""
+    out = 0.0
+    if g.norm() > 0.0:
+        out = rho * l0 * ti.max(a.dot(g) / g.norm(), 0.0)
+    return out
+
+
 def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bool = False):
     """``base`` with the ``--surface own`` pass (module docstring); ``per_area``: divided by
     the tangential moment's c_i (the area a surface particle holds, over l0^2); ``spacing``
@@ -138,18 +149,16 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
                 i = self.state.spread(at)
                 g = self.colour[i]
                 if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and g.norm() > 0.0:
-                    inward = self.accel[i].dot(g) / g.norm()
+                    l0 = self.coef.l0[None]
+                    p = factor * own_normal_stress(self.coef.rho[None], l0, self.accel[i], g)
                     if ti.static(per_area):
-                        inward /= self.share[i]
+                        p /= self.share[i]
                     if ti.static(spacing):
-                        l0 = self.coef.l0[None]
                         near = 2.0 * l0
                         self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                      self._nearest_along, near)
-                        inward *= (l0 / ti.min(ti.max(near, 0.5 * l0), 2.0 * l0)) ** (
-                            self.dim - 1)
-                    self.state.pressure[i] = factor * self.coef.rho[None] * self.coef.l0[None] * (
-                        ti.max(inward, 0.0))
+                        p *= (l0 / ti.min(ti.max(near, 0.5 * l0), 2.0 * l0)) ** (self.dim - 1)
+                    self.state.pressure[i] = p
 
     return OwnPressureStress
 
@@ -183,12 +192,9 @@ def blend_pressure_member(base):
         def _blend(self):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
-                g = self.colour[i]
                 if self.free[i] == 1:
-                    own = 0.0
-                    if g.norm() > 0.0:
-                        own = self.coef.rho[None] * self.coef.l0[None] * ti.max(
-                            self.accel[i].dot(g) / g.norm(), 0.0)
+                    own = own_normal_stress(self.coef.rho[None], self.coef.l0[None],
+                                            self.accel[i], self.colour[i])
                     self.state.pressure[i] = ti.min(self.state.pressure[i], own)
 
     return BlendPressureStress
@@ -232,19 +238,9 @@ def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1) -> float
     """a_membrane / a: the flat lattice face's normaliser a (lattice.stress_normaliser) with
     each pair's stress weighted by phi_ij (``membrane_weight``, ``membrane_member``), over the
     member's a."""
-    from crowndemo.core import lattice
-    offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
-    f = lattice.stress_pair_kernel(np.linalg.norm(offs, axis=1), re_over_l0)
-    g = lattice.colour_gradient_column(dim, 1.0, re_over_l0)
-    full = part = 0.0
-    for k in range(len(g)):
-        for off, ff in zip(offs, f):
-            kj = k - int(round(off[-1]))
-            if off[0] > 0 and 0 <= kj < len(g):
-                t = off[0] ** 2 * ff * (g[k] + g[kj])
-                full += t
-                part += t * membrane_weight(g[k], g[kj], ref)
-    return full / part
+    f = pair_kernel("quartic")
+    return cut_sum(dim, f, re_over_l0) / cut_sum(
+        dim, f, re_over_l0, phi=lambda gi, gj: membrane_weight(gi, gj, ref))
 
 
 def membrane_member(base, dim: int, ref: float):
@@ -450,15 +446,13 @@ def pair_kernel(name: str):
     return f
 
 
-def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
-    """(K_d, a) for the pair kernel ``name`` in units of l0 = 1, as lattice.stress_gradient_norm
-    and lattice.stress_normaliser compute them for the member's."""
+def cut_sum(dim: int, kernel, re: float = 2.1, reach: float = None, phi=None) -> float:
+    """The sum lattice.stress_normaliser inverts, l0 = 1: over the layers k of a flat lattice
+    face and the lattice offsets r (|r| < reach, default re) from layer k to a layer k' >= 0
+    with r_x > 0, r_x^2 f_d(|r|) (|g_k| + |g_k'|), each term times phi(|g_k|, |g_k'|) if
+    given; |g| the colour column (lattice.colour_gradient_column, support re)."""
     from crowndemo.core import lattice
-    kernel = pair_kernel(name)
-    reach = re * max(PAIR_SUPPORT.get(name, 1.0), 1.0)
-    offs = lattice.lattice_offsets(dim, 1.0, reach)
-    Kd = dim / float((np.linalg.norm(offs, axis=1) ** 2
-                      * kernel(np.linalg.norm(offs, axis=1), re)).sum())
+    offs = lattice.lattice_offsets(dim, 1.0, reach or re)
     f = kernel(np.linalg.norm(offs, axis=1), re)
     g = lattice.colour_gradient_column(dim, 1.0, re)
     total = 0.0
@@ -466,8 +460,20 @@ def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
         for off, ff in zip(offs, f):
             kj = k - int(round(off[-1]))
             if off[0] > 0 and kj >= 0:
-                total += off[0] ** 2 * ff * (g[k] + (g[kj] if kj < len(g) else 0.0))
-    return Kd, 1.0 / (Kd * total)
+                gj = g[kj] if kj < len(g) else 0.0
+                total += off[0] ** 2 * ff * (g[k] + gj) * (phi(g[k], gj) if phi else 1.0)
+    return total
+
+
+def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
+    """(K_d, a) for the pair kernel ``name`` in units of l0 = 1, as lattice.stress_gradient_norm
+    and lattice.stress_normaliser compute them for the member's."""
+    from crowndemo.core import lattice
+    kernel = pair_kernel(name)
+    reach = re * max(PAIR_SUPPORT.get(name, 1.0), 1.0)
+    r = np.linalg.norm(lattice.lattice_offsets(dim, 1.0, reach), axis=1)
+    Kd = dim / float((r ** 2 * kernel(r, re)).sum())
+    return Kd, 1.0 / (Kd * cut_sum(dim, kernel, re, reach))
 
 
 @ti.func
@@ -535,6 +541,14 @@ def _strip_moment(d, r, gn, unit, fd):
     return (gn[None] * rt2 * fd).sum(axis=1)
 
 
+@functools.lru_cache(maxsize=None)
+def _flat_moment(beta: float, re: float, width: int, kernel: str) -> float:
+    """B0 of ``flat_tension``: the tangential moment of the lattice strip's outer particle at
+    the origin (s = 1)."""
+    p, d, r, gn, unit, fd = _strip(1.0, beta, re, width, kernel)
+    return float(_strip_moment(d, r, gn, unit, fd)[np.argmin(np.abs(p).sum(axis=1))])
+
+
 def flat_tension(s: float, beta: float, re: float = 2.1, width: int = 60,
                  moment_power: float = 0.0, kernel: str = "quartic") -> float:
     """The tension a flat 2D lattice surface transmits when its outer layer's in-plane spacing
@@ -547,8 +561,7 @@ def flat_tension(s: float, beta: float, re: float = 2.1, width: int = 60,
     Kd, a = pair_normalisers(2, kernel, re)
     p, d, r, gn, unit, fd = _strip(s, beta, re, width, kernel)
     if moment_power:
-        q, dq, rq, gq, uq, fq = _strip(1.0, beta, re, width, kernel)
-        B0 = _strip_moment(dq, rq, gq, uq, fq)[np.argmin(np.abs(q).sum(axis=1))]
+        B0 = _flat_moment(beta, re, width, kernel)
         B = _strip_moment(d, r, gn, unit, fd)
         c = np.where(B > 0, np.clip(B0 / np.maximum(B, 1e-30), 0.25, 4.0), 1.0)
         gn = gn * c ** moment_power
