@@ -22,9 +22,10 @@ BAND = 1e-5          # relative band around re^2 left undecided
 
 class Walker:
     """Records, for each particle i, the j that for_each_neighbour (or with ``near``, the
-    row-clipping for_each_near of the collision model) visits (count -1: not walked)."""
+    row-clipping for_each_near of the collision model; with ``wide``, the surface stress's
+    for_each_wide) visits (count -1: not walked)."""
 
-    def __init__(self, sim: Simulator, near: bool = False):
+    def __init__(self, sim: Simulator, near: bool = False, wide: bool = False):
         cap = sim.state.capacity
         self.nbr = ti.field(ti.i32, (cap, MAX_NBR))
         self.count = ti.field(ti.i32, cap)
@@ -44,6 +45,8 @@ class Walker:
                     c = 0
                     if ti.static(near):
                         grid.for_each_near(i, state.pos[i], re2, record, c)
+                    elif ti.static(wide):
+                        grid.for_each_wide(i, state.pos[i], re2, record, c)
                     else:
                         grid.for_each_neighbour(i, state.pos[i], re2, record, c)
                 count[i] = c
@@ -326,3 +329,44 @@ def test_stencil_holds_every_pair_within_re(dim, reach):
     # with two offsets of +-3 and the third +-2 or +-3 (nearest-corner distance
     # sqrt(2^2 + 2^2 + 1) h >= 3 h = re): 3 x 8 + 8 = 32 of 343; for k <= 2 none
     assert visited == {2: {1: 9, 2: 25, 3: 49}, 3: {1: 27, 2: 125, 3: 343 - 32}}[dim][reach]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("reach", REACHES)
+@pytest.mark.parametrize("max_cells", ["big", "small"])
+def test_wide_walk_matches_brute_force(dim, reach, max_cells):
+    """The wide walk (``for_each_wide``) of a grid made for the surface stress's pair support
+    H = 3 l0 (Model.wide_walk = 3 / 2.1): every pair within H, none beyond, with the cell side
+    re/k and grown under a small cell limit; and the walk at re on the same grid is unchanged."""
+    from crowndemo.core.params import STRESS_PAIR_SUPPORT
+    physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0728,
+                      gravity=0.0)
+    sim = Simulator(physics, Numerics(cells_per_re=reach, surface_tension="stress"), CAPACITY,
+                    BIG[dim] if max_cells == "big" else SMALL)
+    assert sim.grid.wide == pytest.approx(STRESS_PAIR_SUPPORT / RE_RATIO)
+    pos = random_cloud(dim, 90 + 10 * dim + reach, n_box=CLOUD[dim]["n_box"] // 3,
+                       box_re=CLOUD[dim]["box_re"], far_re=40.0)
+    kind = np.full(len(pos), FLUID, dtype=np.int32)
+    sim.load(pos, np.zeros_like(pos), kind)
+    sim.grid.build(RE)
+    check_against_brute_force(sim, Walker(sim, wide=True), as_loaded(sim), kind,
+                              radius=STRESS_PAIR_SUPPORT * L0)
+    check_against_brute_force(sim, Walker(sim), as_loaded(sim), kind)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("reach", REACHES)
+def test_wide_stencil_holds_every_pair_within_its_radius(dim, reach):
+    """``row_reach`` for a walk radius of k x 3/2.1 cells (not a whole number): every cell
+    offset that a pair within that radius can span lies in a visited row and reach."""
+    span = reach * 3.0 / 2.1
+    rng = np.random.default_rng(80 + 10 * dim + reach)
+    h = 1.0 / reach                                    # re = 1, the radius span h
+    x = rng.uniform(0.0, h, size=(200_000, dim))
+    u = rng.normal(size=(len(x), dim))
+    u *= span * h * (rng.uniform(size=(len(x), 1)) ** (1.0 / dim)) / np.linalg.norm(
+        u, axis=1)[:, None]
+    cell = np.floor((x + u) / h).astype(int)
+    for o in np.unique(cell, axis=0):
+        reach_row = row_reach(tuple(o[1:]), span)
+        assert reach_row >= 0 and abs(o[0]) <= reach_row, f"cell offset {o} not walked"

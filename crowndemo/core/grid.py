@@ -8,10 +8,15 @@ lies within k cells on each axis. The walk visits only the cells of that (2k + 1
 can hold a point within re of the particle's own cell (a stencil fixed at compile time: all 125
 for k = 2, 311 of 343 for k = 3), row by row along axis 0, where cells are contiguous in cell
 order. The grid is padded with k empty cells on every side, so a row never needs a bounds test.
+A grid made ``wide`` (> 1) also has a second, wider walk (``for_each_wide``) to wide x re, for a
+pass whose pair kernel reaches beyond re (the surface stress's divergence, C3): its stencil is
+the cells within ceil(k wide) of the centre that can hold such a point, and the padding is that
+wide; the walks at re are the same as without it.
 If the live particles spread so far that the cells would not fit in ``max_cells``, the cell side
 grows: the walk stays exact, only more candidate pairs are visited.
 """
 
+import math
 import warnings
 from typing import Iterable
 
@@ -29,34 +34,43 @@ warnings.filterwarnings("ignore", message="You are unrolling more than", categor
 FAR = 1.0e30       # |coordinate| beyond this (inf, NaN fails the test too) is not a bound
 
 
-def row_reach(off: Iterable[int], k: int) -> int:
+def row_reach(off: Iterable[int], k: float) -> int:
     """How far along axis 0 the walk's row at cell offset ``off`` (axes 1..d-1) reaches, in
-    cells of side h = re/k: the largest |o_0| such that the cell at (o_0, off) can hold a point
-    within re of a point of the centre cell, sum_m (max(|o_m| - 1, 0) h)^2 < re^2; -1 when no
-    cell of the row can. A larger h (the side grown under the cell limit) only shrinks the true
-    set, so the stencil holds for every h >= re/k."""
+    cells of side h = re/k (k cells per walk radius; not a whole number for the wide walk): the
+    largest |o_0| such that the cell at (o_0, off) can hold a point within k h of a point of
+    the centre cell, sum_m (max(|o_m| - 1, 0) h)^2 < (k h)^2; -1 when no cell of the row can. A
+    larger h (the side grown under the cell limit) only shrinks the true set, so the stencil
+    holds for every h >= re/k."""
     across = sum(max(abs(int(o)) - 1, 0) ** 2 for o in off)
     if across >= k * k:
         return -1
     reach = 0
-    while reach < k and reach * reach + across < k * k:
+    while reach < math.ceil(k) and reach * reach + across < k * k:
         reach += 1
     return reach
 
 
-def min_cells(dim: int, cells_per_re: int) -> int:
+def span_cells(cells_per_re: int, wide: float = 1.0) -> int:
+    """The cells a walk to wide x re spans on each side of its own: ceil(k wide)."""
+    return int(math.ceil(cells_per_re * max(wide, 1.0) - 1e-9))
+
+
+def min_cells(dim: int, cells_per_re: int, wide: float = 1.0) -> int:
     """The fewest cells a grid needs: one cell with its padding and one to spare per axis, so
     that a growing cell side always ends within the limit."""
-    return (2 * int(cells_per_re) + 3) ** dim
+    return (2 * span_cells(cells_per_re, wide) + 3) ** dim
 
 
 @ti.data_oriented
 class CellGrid:
-    def __init__(self, state: ParticleState, max_cells: int, cells_per_re: int = 2):
+    def __init__(self, state: ParticleState, max_cells: int, cells_per_re: int = 2,
+                 wide: float = 1.0):
         d = self.dim = state.dim
         self.reach = int(cells_per_re)      # cells of side re/reach; walk (2 reach + 1)^d
+        self.wide = max(float(wide), 1.0)   # for_each_wide's radius over re
+        self.pad = span_cells(self.reach, self.wide)   # empty cells on every side
         self.state = state
-        self.max_cells = max(int(max_cells), min_cells(d, self.reach))   # cells allocated
+        self.max_cells = max(int(max_cells), min_cells(d, self.reach, self.wide))   # allocated
         self.cell_limit = ti.field(ti.i32, shape=())   # cells used at most (<= max_cells)
         self.cell_limit[None] = self.max_cells
         self.lo = ti.field(float, d)
@@ -91,7 +105,7 @@ class CellGrid:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
         grid allocated larger gives the same cells, and results, as one allocated to fit."""
         self.cell_limit[None] = max(min(int(cells), self.max_cells),
-                                    min_cells(self.dim, self.reach))
+                                    min_cells(self.dim, self.reach, self.wide))
 
     def nbytes(self) -> int:
         from .state import field_nbytes
@@ -137,7 +151,7 @@ class CellGrid:
                 for k in ti.static(range(d)):
                     self.lo[k] = 0.0
                     self.hi[k] = 0.0
-            pad = ti.static(self.reach)    # empty cells on every side (module docstring)
+            pad = ti.static(self.pad)      # empty cells on every side (module docstring)
             cells = 1.0
             for k in ti.static(range(d)):
                 cells *= (self.hi[k] - self.lo[k]) / h + 2.0 + 2.0 * pad
@@ -219,7 +233,7 @@ class CellGrid:
         c = ti.Vector([0] * self.dim)
         for k in ti.static(range(self.dim)):
             ck = ti.cast(ti.floor((x[k] - self.origin[k]) / self.side[None]), ti.i32)
-            c[k] = ti.min(ti.max(ck, self.reach), self.dims[k] - 1 - self.reach)
+            c[k] = ti.min(ti.max(ck, self.pad), self.dims[k] - 1 - self.pad)
         return c
 
     @ti.func
@@ -235,19 +249,27 @@ class CellGrid:
         """Call ``task(i, j, rij, r2, acc)`` for every live j with 0 < r2 = |rij|^2 < re2,
         rij = x_j - x_i, at the positions of the last ``build``; re2 at most the square of the
         ``min_side`` it was given (the stencil of the module docstring holds up to that)."""
-        self._walk(i, xi, re2, task, acc, False)
+        self._walk(i, xi, re2, task, acc, False, self.reach)
+
+    @ti.func
+    def for_each_wide(self, i, xi, r2, task: ti.template(), acc: ti.template()):
+        """``for_each_neighbour`` to a radius sqrt(r2) of at most ``wide`` times the
+        ``min_side`` of the last build (a grid made with ``wide`` > 1)."""
+        self._walk(i, xi, r2, task, acc, False, self.reach * self.wide)
 
     @ti.func
     def for_each_near(self, i, xi, r2_max, task: ti.template(), acc: ti.template()):
         """``for_each_neighbour`` for a radius well under re (the collision distance): each
         row of cells is clipped to the sphere, so only the few cells that reach it are
         visited. (Clipping costs more per row than it saves at radius re: BENCHMARKS.md.)"""
-        self._walk(i, xi, r2_max, task, acc, True)
+        self._walk(i, xi, r2_max, task, acc, True, self.reach)
 
     @ti.func
-    def _walk(self, i, xi, re2, task: ti.template(), acc: ti.template(), clip: ti.template()):
+    def _walk(self, i, xi, re2, task: ti.template(), acc: ti.template(), clip: ti.template(),
+              span: ti.template()):
+        """The stencil's rows for a walk radius of ``span`` cells of side re/reach."""
         d = ti.static(self.dim)
-        k = ti.static(self.reach)
+        k = ti.static(int(math.ceil(span - 1e-9)))
         c = self.cell_of(xi)
         h = self.side[None]
         stride = ti.Vector([1] * d)       # of the cell index along each axis
@@ -255,7 +277,7 @@ class CellGrid:
             stride[m] = stride[m - 1] * self.dims[m - 1]
         centre = self.linear(c)
         for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
-            reach = ti.static(row_reach(off, k))
+            reach = ti.static(row_reach(off, span))
             if ti.static(reach >= 0):      # rows that cannot hold a neighbour are not compiled
                 first = centre - reach     # the row's first cell
                 for m in ti.static(range(1, d)):

@@ -16,6 +16,9 @@ COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5;
 # continuum surface stress (method.md §4c) or the curvature-based pressure boundary condition
 # P = sigma kappa (Tsujimura et al. 2023; experimental)
 SURFACE_TENSION_MODELS = ("potential", "stress", "curvature")
+# the surface stress's divergence pair kernel reaches STRESS_PAIR_SUPPORT l0 (method.md C3):
+# beyond re = 2.1 l0, so its walk is the grid's wide one (grid.py)
+STRESS_PAIR_SUPPORT = 3.0
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
@@ -167,6 +170,7 @@ class Model:
     mirror_planes: Tuple[int, ...] = ()   # symmetry planes (symmetry.py)
     predictor_list: bool = False     # the predictor's pairs from the last list (terms.py)
     surface_tension_model: str = "potential"   # the family member (core/surface_tension/)
+    wide_walk: float = 1.0           # the grid's wide walk over re (grid.py; stress C3)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
@@ -175,7 +179,9 @@ class Model:
                    numerics.cells_per_re, numerics.wall_model == "plane",
                    numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
                    numerics.predictor_list and numerics.neighbour_list,
-                   numerics.surface_tension)
+                   numerics.surface_tension,
+                   max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio)
+                   if physics.sigma > 0 and numerics.surface_tension == "stress" else 1.0)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,

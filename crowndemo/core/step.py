@@ -108,9 +108,11 @@ FIELD_ENTRIES_MAX = 2 ** 31 - 1
 
 def capacity_for(scene) -> int:
     """The particles a simulator must hold for ``scene``: its particles, and room for their
-    mirror images when it has symmetry planes (symmetry.image_room)."""
+    mirror images when it has symmetry planes (symmetry.image_room), within the widest walk's
+    reach (re, or the surface stress's pair support: Model.wide_walk)."""
     planes = scene.numerics.mirror_planes
-    return len(scene.pos) + image_room(scene.pos, planes, scene.physics.re)
+    reach = scene.physics.re * Model.of(scene.physics, scene.numerics).wide_walk
+    return len(scene.pos) + image_room(scene.pos, planes, reach)
 
 
 def entries_per_particle(model: Model) -> int:
@@ -165,7 +167,7 @@ class Simulator:
         self.state = ParticleState(dim, capacity)
         self._auto_cells = max_cells is None    # then the cell limit follows the particles
         self.grid = CellGrid(self.state, max_cells or default_max_cells(capacity),
-                             self.model.cells_per_re)
+                             self.model.cells_per_re, self.model.wide_walk)
         self.coef = Coefficients(dim)
         self.operators = Operators(self.grid, self.coef)
         self.floor = PlaneFloor() if self.model.plane_floor else None   # else not allocated
@@ -213,7 +215,7 @@ class Simulator:
         if self.floor is not None:
             self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio))
         if self.symmetry is not None:
-            self.symmetry.configure(self.lattice.re)
+            self.symmetry.configure(self.lattice.re * self.model.wide_walk)
         self._lists_ready = False
 
     def load(self, pos: np.ndarray, vel: np.ndarray, kind: np.ndarray) -> None:

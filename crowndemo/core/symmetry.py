@@ -1,7 +1,8 @@
 """Mirror symmetry planes through the scene's axis (x = 0, and y = 0 in 3D): one half or one
 quarter of a symmetric scene is simulated, and every neighbour sum sees the mirrored rest.
 
-Once per grid build, every particle within re of a plane gets a mirror image across it (near
+Once per grid build, every particle within re of a plane (within the surface stress's pair
+support, 3 l0, where that model's wide walk reaches further) gets a mirror image across it (near
 two planes, also the image across both), stored after the particles, in slots [n, n + images):
 the source's kind, its position and velocity reflected. The grid holds the images, so every
 pass that walks it (number density S9, viscosity S12, surface tension S22, pressure gradient
@@ -138,7 +139,8 @@ class Symmetry:
         self.crossings = ti.field(ti.i32, shape=())       # reflections so far (diagnostic)
 
     def configure(self, reach: float) -> None:
-        """Particles within ``reach`` (re) of a plane have images."""
+        """Particles within ``reach`` (re, or the grid's wide walk's radius) of a plane have
+        images."""
         self.reach[None] = reach
 
     def clear(self) -> None:
