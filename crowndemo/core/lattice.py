@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import ParameterError
+from .params import STRESS_PAIR_SUPPORT, ParameterError
 
 # l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
 # user's spacing is checked against its command's own, narrower range first (cli/info_lattice.py)
@@ -84,21 +84,32 @@ def stress_kernel(r: np.ndarray, re: float) -> np.ndarray:
     return np.where(r < re, (1.0 - np.minimum(r, re) / re) ** 3, 0.0)
 
 
-def stress_pair_kernel(r: np.ndarray, re: float) -> np.ndarray:
-    """f_d(r) = 1 - (r/re)^4 for r < re, else 0: the divergence's pair weight (C3). The pair
-    force r f_d(r) grows with r up to re / 5^(1/4) = 1.4 l0 (re = 2.1 l0), so a tension along
-    the surface pulls two particles less as they close (no clumping at the lattice spacing).
-    The step's kernel also has a repulsive core below l0 (surface_tension/stress.py), where no
-    lattice pair lies: the lattice sums here do not see it."""
+def stress_pair_support(l0: float) -> float:
+    """H = STRESS_PAIR_SUPPORT l0 = 3 l0: the support of the divergence's pair weight (C3)."""
+    return STRESS_PAIR_SUPPORT * l0
+
+
+def stress_pair_kernel(r: np.ndarray, h: float) -> np.ndarray:
+    """f_d(r) = (1 - (r/h)^4)^2 for r < h, else 0, h = H (stress_pair_support): the
+    divergence's pair weight (C3). Zero with zero slope at h, so the tension a flat surface
+    carries hardly depends on how closely its outer layer sits (within 5 % for spacings
+    0.95-1.15 l0; VALIDATION.md, "The pair kernel's edge"); the pair force r f_d(r) grows with
+    r up to 0.58 h = 1.74 l0, so a tension along the surface pulls two particles less as they
+    close (no clumping at the lattice spacing). The step's kernel also has a repulsive core
+    below l0 (surface_tension/stress.py), where no lattice pair lies: the lattice sums here do
+    not see it."""
     r = np.asarray(r, dtype=float)
-    return np.where(r < re, 1.0 - (np.minimum(r, re) / re) ** 4, 0.0)
+    return np.where(r < h, (1.0 - (np.minimum(r, h) / h) ** 4) ** 2, 0.0)
 
 
-def stress_gradient_norm(dim: int, l0: float, re: float, kernel=stress_kernel) -> float:
-    """K = d / sum_j r^2 f(r) on the lattice: the normalisation that makes the pair sum
-    K sum_j (phi_j - phi_i) r_ij f(r_ij) the exact gradient of a linear phi (C1, C3)."""
-    r = np.linalg.norm(lattice_offsets(dim, l0, re), axis=1)
-    return dim / float((r ** 2 * kernel(r, re)).sum())
+def stress_gradient_norm(dim: int, l0: float, re: float, kernel=stress_kernel,
+                         support: float = None) -> float:
+    """K = d / sum_j r^2 f(r) on the lattice, over the offsets within ``support`` (re if not
+    given; f = kernel(r, support)): the normalisation that makes the pair sum K sum_j (phi_j -
+    phi_i) r_ij f(r_ij) the exact gradient of a linear phi (C1, C3)."""
+    h = re if support is None else support
+    r = np.linalg.norm(lattice_offsets(dim, l0, h), axis=1)
+    return dim / float((r ** 2 * kernel(r, h)).sum())
 
 
 def colour_gradient_column(dim: int, l0: float, re: float) -> np.ndarray:
@@ -120,11 +131,12 @@ def stress_normaliser(dim: int, l0: float, re: float) -> float:
     """a of the surface-stress model (method.md §4c, C2): the factor that makes the flat
     lattice surface carry sigma. Across a cut normal to x through the half-space, the sum form
     of the divergence (C3) transmits, per unit length of the surface (and depth in 2D),
-    a sigma l0 K sum_k sum_{r_x > 0} r_x^2 f(r) (|g_k| + |g_k'|) (j = i + r in layer k');
-    a makes that sigma. Dimensionless."""
-    offs = lattice_offsets(dim, l0, re)
-    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), re)
-    K = stress_gradient_norm(dim, l0, re, stress_pair_kernel)
+    a sigma l0 K_d sum_k sum_{r_x > 0} r_x^2 f_d(r) (|g_k| + |g_k'|) (j = i + r in layer k',
+    |r| < H); a makes that sigma. Dimensionless."""
+    h = stress_pair_support(l0)
+    offs = lattice_offsets(dim, l0, h)
+    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
+    K = stress_gradient_norm(dim, l0, re, stress_pair_kernel, h)
     g = colour_gradient_column(dim, l0, re)
     m = len(g) - 1
     total = 0.0
@@ -162,7 +174,8 @@ class LatticeConstants:
         return cls(dim, l0, re, n0, lam, surface_tension_coefficient(dim, l0, re, sigma),
                    rho * l0 ** dim, stress_normaliser(dim, l0, re),
                    stress_gradient_norm(dim, l0, re),
-                   stress_gradient_norm(dim, l0, re, stress_pair_kernel))
+                   stress_gradient_norm(dim, l0, re, stress_pair_kernel,
+                                        stress_pair_support(l0)))
 
 
 def lattice_cohesion_pressure(dim: int, l0: float, re: float, C: float) -> float:

@@ -8,7 +8,8 @@ lattice continued below the surface, wall particles at s = -l0/2 and ``layers - 
 layers under them. The tables are summed for a particle right above a column of that lattice,
 so a fluid lattice at rest sees exactly the number density it would see with the particles;
 a particle between columns sees the same values (the particle floor's lateral ripple is left
-out). Per height s, five sums over the layers' points j within re:
+out). Per height s, five sums over the layers' points j within re (within H = 3 l0 for d_floor,
+the divergence's pair support):
 
 - n_floor(s) = sum over every layer of w(r)                 -> number density (S9)
 - g_floor(s) = sum over the wall layer of (z_j - z_i) w / r^2 -> pressure gradient (S11), the
@@ -31,7 +32,7 @@ from typing import Tuple
 import numpy as np
 import taichi as ti
 
-from .lattice import stress_kernel, stress_pair_kernel, weight
+from .lattice import stress_kernel, stress_pair_kernel, stress_pair_support, weight
 
 SAMPLES = 1024
 FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C, FLOOR_D = 0, 1, 2, 3, 4
@@ -41,11 +42,12 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
                  samples: int = SAMPLES) -> Tuple[float, float, np.ndarray]:
     """(s0, ds, table[samples, 5]): n_floor, g_floor (the component along the last axis),
     v_floor, c_floor and d_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
-    collision model has acted; the table holds its last value) to re - l0/2 (beyond, no floor
-    point is within re)."""
-    s0, s1 = -0.25 * l0, re - 0.5 * l0
+    collision model has acted; the table holds its last value) to max(re, H) - l0/2 (beyond, no
+    floor point is within reach)."""
+    h = stress_pair_support(l0)
+    s0, s1 = -0.25 * l0, max(re, h) - 0.5 * l0
     ds = (s1 - s0) / (samples - 1)
-    m = int(math.ceil(re / l0))
+    m = int(math.ceil(max(re, h) / l0))
     lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
     lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
     lat2 = (lateral ** 2).sum(axis=1)
@@ -58,7 +60,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int,
             w = weight(r, re)
             table[k, FLOOR_N] += w.sum()
             table[k, FLOOR_C] += (dz * stress_kernel(r, re)).sum()
-            table[k, FLOOR_D] += (dz * stress_pair_kernel(r, re)).sum()
+            table[k, FLOOR_D] += (dz * stress_pair_kernel(r, h)).sum()
             if layer == 0:
                 table[k, FLOOR_G] += (dz / (r * r) * w).sum()
                 table[k, FLOOR_V] += w.sum()

@@ -82,7 +82,8 @@ def _laplace(dim: int) -> Case:
     # the lattice-cut drop's staircase relaxes on the capillary time scale: over its first
     # mode-2 period the inside pressure reads 20-35 % high at R/l0 = 8-16, after a few periods
     # within a few % (the free drop's second half over 10 periods: 1.21 / 1.00 / 0.96 sigma/R
-    # at R/l0 = 8 / 12 / 16 in 2D). So: 5 periods, averaged over the last 2.5
+    # at R/l0 = 8 / 12 / 16 in 2D with the first member, 1.04 / 1.03 / 0.99 with the member of
+    # 2026-12-05). So: 5 periods, averaged over the last 2.5
     periods = 5.0
 
     def run(l0: float, numerics: Numerics) -> Outcome:

@@ -7,7 +7,8 @@ tensor (Lafaurie et al., J. Comput. Phys. 113, 1994; in SPH Hu & Adams, J. Compu
 with g the gradient of the liquid's colour (1 in the liquid, 0 outside). T is a tension along
 the surface layer with no normal component: on a flat surface its divergence vanishes, on a
 curved one it sums to sigma kappa n over the layer, the Young-Laplace jump, with no curvature
-computed. Two neighbour passes at r*, after the number density (S17):
+computed. Two neighbour passes at r*, after the number density (S17), and the free surface's
+pressure:
 
 1. the colour gradient (C1), g_i = omega_i K sum_j r_ij f(r_ij) over every neighbour kind,
    f(r) = (1 - r/re)^3 (a Wendland C2 kernel's gradient: bounded where the MPS w/r^2 is not;
@@ -20,21 +21,36 @@ computed. Two neighbour passes at r*, after the number density (S17):
    then T_i = sigma a (|g_i| I - g_i g_i^T / |g_i|), a the lattice normaliser that makes a
    flat lattice surface carry exactly sigma (lattice.stress_normaliser);
 2. the divergence in the sum form (C3),
-   a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij),  f_d(r) = 1 - (r/re)^4,
+   a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij),  f_d(r) = (1 - (r/H)^4)^2, H = 3 l0,
    T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d. Each pair's terms are equal
    and opposite (for a fluid j), so the model conserves momentum exactly: a free drop cannot
-   drift by its own surface tension. The pair force r f_d(r) grows with r up to 1.4 l0, so the
-   tension along the surface pulls two surface particles less as they close; with a pair
-   weight that peaks closer in (f, or w/r^2) the surface layer clumped within 2 ms. Below
-   l0, where no lattice pair lies (the normalisations do not see it), f_d is multiplied by
-   (r/l0 - 0.75)/0.25, so the tension turns into a repulsion for pairs closer than 0.75 l0:
-   free-surface particles have P = 0 (M3), and without the core two of them pulled together
-   met no pressure until n > n0, then a third one's arrival kicked one out of a resting drop
-   at 0.2-0.4 m/s (R/l0 = 8, once in 95 ms at c = 13 m/s, several at 2.7 m/s; with the core
-   none, and the largest speed stays under 6 mm/s). The idea is the repulsive core of the
-   seed's potential (S22, r < l0) and Monaghan's (2000) cure for the tensile instability.
+   drift by its own surface tension. f_d is zero with zero slope at H, beyond the lattice's
+   pairs at 2 l0, so the tension a surface carries hardly depends on how closely its outer
+   layer sits (within 5 % over 0.95-1.15 l0; the first member's 1 - (r/re)^4, support re,
+   had its edge at the lattice's 2 l0 pairs and carried 1.40 sigma when the layer packed to
+   0.85 l0, 0.75 sigma stretched to 1.05 l0: VALIDATION.md, "The pair kernel's edge"). This
+   pass walks to H beyond re (the grid's wide walk, grid.py). The pair force r f_d(r) grows
+   with r up to 0.58 H = 1.74 l0, so the tension along the surface pulls two surface particles
+   less as they close; with a pair weight that peaks closer in (f, w/r^2, or this one with H =
+   re: 1.21 l0) the surface layer clumped. Below l0, where no lattice pair lies (the
+   normalisations do not see it), f_d is multiplied by (r/l0 - 0.75)/0.25, so the tension
+   turns into a repulsion for pairs closer than 0.75 l0: without the core two surface
+   particles pulled together met no pressure until n > n0, then a third one's arrival kicked
+   one out of a resting drop at 0.2-0.4 m/s. The idea is the repulsive core of the seed's
+   potential (S22, r < l0) and Monaghan's (2000) cure for the tensile instability;
+3. the free surface's pressure (C4): a fluid particle that S17/M3 left at P = 0 and that has a
+   colour gradient takes the normal stress its own tension carries,
+   P_i = rho l0 max(0, a_i . g_i/|g_i|),
+   the force a_i pulls it in with, over the area l0^(d-1) it holds. With P = 0 on the surface
+   only the liquid a spacing inside carried the inside pressure (60-83 % of a 3D drop's volume
+   at R/l0 = 8-16, the virial, VALIDATION.md), and the first member's 3D drops read 42-59 %
+   high; with C4 the surface layer carries it. The factor 1 is the flat lattice face's
+   balance: the sum form's push of a uniform pressure on a face particle, 2 P G/n0 d, equals
+   its own pull at F = n0/(2 d G) = 1.016 (2D) / 1.011 (3D). It needs no pass: a_i is pass 2's.
 
 The acceleration is applied in the corrector with the pressure gradient (S18-S20), at r*.
+``_pair_weight`` and ``_surface_pressure`` are the member's two choices (C3's f_d, C4), each a
+method, so a study (tools/stress_surface_study.py) can swap one without restating a pass.
 Only fluid particles carry tension; with symmetry planes, images carry their sources' mirrored
 g (``_sync_images``).
 """
@@ -42,7 +58,7 @@ import taichi as ti
 
 from ..coefficients import Coefficients
 from ..grid import CellGrid
-from ..params import Model
+from ..params import STRESS_PAIR_SUPPORT, Model
 from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
@@ -56,11 +72,12 @@ def stress_kernel(r, re):
 
 
 @ti.func
-def stress_pair_kernel(r, re, l0):
-    """f_d(r) = 1 - (r/re)^4 (C3; lattice.stress_pair_kernel), times (r/l0 - CORE)/(1 - CORE)
-    below l0 (the core: no lattice pair lies there)."""
-    q = r / re
+def stress_pair_kernel(r, h, l0):
+    """f_d(r) = (1 - (r/h)^4)^2 for r < h (C3; lattice.stress_pair_kernel), times (r/l0 -
+    CORE)/(1 - CORE) below l0 (the core: no lattice pair lies there)."""
+    q = ti.min(r / h, 1.0)
     f = 1.0 - q * q * q * q
+    f *= f
     if r < l0:
         f *= (r / l0 - CORE) / (1.0 - CORE)
     return f
@@ -99,11 +116,12 @@ class StressTension:
         return field_nbytes(self.colour) + field_nbytes(self.accel)
 
     def boundary_pressure(self) -> None:
-        """The two passes at r* (module docstring); the pressure is left as S17/M3 set it."""
+        """The two passes (module docstring), then the free surface's pressure (C4)."""
         self._colour()
         if self.symmetry is not None:
             self._sync_images()
         self._divergence()
+        self._surface_pressure()
 
     @ti.func
     def _colour_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -140,13 +158,19 @@ class StressTension:
             self.colour[s] = self.symmetry._mirrored(self.colour[self.symmetry.source[s]], s)
 
     @ti.func
+    def _pair_weight(self, r):
+        """f_d(r) with its core (C3)."""
+        l0 = self.coef.l0[None]
+        return stress_pair_kernel(r, STRESS_PAIR_SUPPORT * l0, l0)
+
+    @ti.func
     def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
         kind_j = self.state.kind[j]
         if kind_j != GONE:
             f = stress_times(self.colour[i], rij)
             if kind_j == FLUID:
                 f += stress_times(self.colour[j], rij)
-            acc += f * stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], self.coef.l0[None])
+            acc += f * self._pair_weight(ti.sqrt(r2))
 
     @ti.kernel
     def _divergence(self):
@@ -154,17 +178,29 @@ class StressTension:
         g g^T/|g|) (C2), T_j = 0 for walls and dummies (the plane floor's layers: d_floor)."""
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
+        reach2 = (STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2      # H^2: the wide walk
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             if self.state.kind[i] == FLUID:
                 acc = ti.Vector.zero(float, self.dim)
-                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
-                                             self._divergence_pair, acc)
+                self.grid.for_each_wide(i, self.state.pos[i], reach2, self._divergence_pair, acc)
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
                     ez[self.dim - 1] = self.floor.divergence_at(self.state.pos[i][self.dim - 1])
                     acc += stress_times(self.colour[i], ez)
                 self.accel[i] = scale * acc
+
+    @ti.kernel
+    def _surface_pressure(self):
+        """C4: P_i = rho l0 max(0, a_i . g_i/|g_i|) for the fluid particles S17/M3 left at
+        P = 0 that have a colour gradient (the free surface: omega_i > 0)."""
+        scale = self.coef.rho[None] * self.coef.l0[None]
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
+            g = self.colour[i]
+            gl = g.norm()
+            if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and gl > 0.0:
+                self.state.pressure[i] = scale * ti.max(self.accel[i].dot(g) / gl, 0.0)
 
     @ti.func
     def acceleration(self, i):
