@@ -1,14 +1,22 @@
 """The surface-stress member's resting-drop diagnostics of VALIDATION.md ("What the surface
-layer does", issue 23), reproducible:
+layer does" and after, issue 23), reproducible:
 
-    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS
-                          [--surface neighbours|virial|own|own-spacing|blend] [--core X]
+    .venv/bin/python tools/stress_surface_study.py drop DIM R/l0 T_MS [--base first|member]
+                          [--surface zero|neighbours|virial|own|own-spacing|blend|eos|cumulative]
+                          [--pair-kernel quartic|smooth|smooth2|smooth25|smooth3] [--core X]
                           [--isotropic-core]
                           [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
-                          [--virial-moment] [--profile]
+                          [--virial-moment] [--theta-slope C] [--profile]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
+
+``--base first`` (the default): the first member, whose figures the study tables up to
+2026-12-05 give: f_d = 1 - (r/re)^4 and P = 0 on the free surface (``first_member``, through
+the member's two hooks, stress._pair_weight and stress._surface_pressure; its runs agree with
+the tables within the drops' run-to-run scatter, ~1 %, not to the digit). ``--base member``:
+the member as stress.py has it (f_d = (1 - (r/H)^4)^2, H = 3 l0, and the free surface's own
+normal stress, C4). ``--surface`` and ``--pair-kernel`` replace the base's choice.
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
 inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
@@ -23,15 +31,20 @@ row of a stress-* validation case (validate/tension_cases.py). ``stretch``: the 
 with the tangential moment (``flat_tension``; numpy, no Taichi).
 
 Experiments, not member options (VALIDATION.md says what each did):
-``--surface neighbours``: free-surface particles (P = 0 after S17/M3) take the w-weighted mean
+``--surface zero``: P = 0 on the free surface (S17/M3 alone); ``--surface neighbours``:
+free-surface particles (P = 0 after S17/M3) take the w-weighted mean
 pressure of their pressurised fluid neighbours before the stress passes; ``--surface virial``:
 the same times n0/n_i (at most 3), so that P_i n_i/n0 is the neighbours' pressure;
 ``--surface own``: after the passes they take the normal stress their own tension carries,
-P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1); with
-``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle holds;
-``--surface own-spacing``: the own normal stress times (l0/s_i)^(d-1), s_i i's nearest
+P_i = F rho l0 max(0, a_i . g_i/|g_i|), F = ``--own-factor`` (default 1: the member's C4);
+with ``--own-per-area`` (and ``--tangential-moment``) divided by c_i, the area the particle
+holds; ``--surface own-spacing``: the own normal stress times (l0/s_i)^(d-1), s_i i's nearest
 neighbour along the surface (own_pressure_member);
 ``--surface blend``: the smaller of the two (neighbours' mean, own normal stress);
+``--surface eos``: the EOS (S17) of the number density over the share of a full neighbourhood
+the particle has, theta = 1 - C |g| l0 (``--theta-slope`` C, fitted on lattice faces);
+``--surface cumulative`` (``--base member``): after C4 a free-surface particle adds the
+w-weighted mean C4 pressure of its free-surface neighbours outward of it (a third pass);
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -39,18 +52,17 @@ instead of through the tangential projection, so a surface particle cannot sink 
 c_i = B0 / B_i, B_i = sum_j |g_j| l0 (|r_ij|^2 - (r_ij . n_i)^2) / l0^2 f_d(r_ij) over fluid j,
 the surface's tangential moment about i (packing raises it), B0 its value at a flat lattice
 face's outer particle; c in [1/X, X], X = ``--moment-clamp`` (default 4); a third pass,
-drops only.
+drops only, ``--base first`` only.
 ``--virial-moment``: the tangential moment's c_i from the unweighted moment, c_i = M0/M_i,
 M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat face's;
 ``--membrane``: each pair's stress (T_i + T_j) weighted by phi_ij = 2 min(|g_i|, |g_j|) /
 (|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
 the tension acts between surface particles only (an inner particle, g = 0, takes none of the
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
-``--pair-kernel smooth``: the divergence's pair weight f_d = (1 - (r/re)^4)^2 (zero slope
-at re) in place of the member's 1 - (r/re)^4, its K_d and a from the lattice
-(pair_normalisers); the tangential moment follows it. ``smooth2`` (the same with support
-2 l0; not with the moments); ``smooth25`` and ``smooth3`` (supports 2.5 and 3 l0) for
-``stretch`` only.
+``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
+``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
+same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
+lattice (pair_normalisers); the tangential moment follows quartic or smooth.
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
@@ -78,7 +90,7 @@ def neighbours_pressure_member(base, scaled: bool = False):
             self.p_new = ti.field(float, self.state.capacity)
 
         def boundary_pressure(self) -> None:
-            self._surface_pressure()
+            self._neighbours_pressure()
             self._commit()
             super().boundary_pressure()
 
@@ -89,7 +101,7 @@ def neighbours_pressure_member(base, scaled: bool = False):
                 acc += ti.Vector([w * self.state.pressure[j], w])
 
         @ti.kernel
-        def _surface_pressure(self):
+        def _neighbours_pressure(self):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
                 self.p_new[i] = self.state.pressure[i]
@@ -163,23 +175,49 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
     return OwnPressureStress
 
 
-def blend_pressure_member(base):
-    """``base`` with ``--surface blend``: a free-surface particle (P = 0 after S17/M3) takes the
-    smaller of its pressurised neighbours' mean (``--surface neighbours``) and the normal stress
-    its own tension carries (``--surface own``, F = 1)."""
+def eos_pressure_member(base, slope: float):
+    """``base`` with ``--surface eos``: a free-surface particle (n_i < beta n0, P = 0 by M3)
+    takes the EOS (S17) of its number density over the share of a full neighbourhood it has,
+    P_i = max(0, c^2 rho (n_i / (theta_i n0) - 1)), theta_i = max(1 - C |g_i| l0, 0.3), g_i the
+    raw colour gradient (C1 without omega), C = ``slope`` fitted on lattice half-spaces of
+    several faces; so the surface layer carries the inside pressure and answers its own
+    density (packing raises it, stretching lowers it)."""
     from crowndemo.core.state import FLUID
-    member = neighbours_pressure_member(base)
 
     @ti.data_oriented
-    class BlendPressureStress(member):
+    class EosPressureStress(base):
+        def boundary_pressure(self) -> None:
+            super().boundary_pressure()
+            self._eos_surface()
+
+        @ti.kernel
+        def _eos_surface(self):
+            n0, beta = self.coef.n0[None], self.coef.beta[None]
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                n = self.state.density[i]
+                if self.state.kind[i] == FLUID and n < beta * n0:
+                    w = self._surface_weight(i)
+                    g = 0.0
+                    if w > 0.0:
+                        g = self.colour[i].norm() / w * self.coef.l0[None]
+                    theta = ti.max(1.0 - slope * g, 0.3)
+                    self.state.pressure[i] = ti.max(
+                        self.coef.c2[None] * self.coef.rho[None] * (n / (theta * n0) - 1.0), 0.0)
+
+    return EosPressureStress
+
+
+def free_marked_member(base):
+    """``base`` with ``free`` (1 for the fluid particles S17/M3 left at P = 0) and ``_mark``,
+    which sets it; the ``--surface blend`` and ``cumulative`` members call it first."""
+    from crowndemo.core.state import FLUID
+
+    @ti.data_oriented
+    class FreeMarkedStress(base):
         def __init__(self, model, grid, coef):
             super().__init__(model, grid, coef)
             self.free = ti.field(ti.i32, self.state.capacity)
-
-        def boundary_pressure(self) -> None:
-            self._mark()
-            super().boundary_pressure()
-            self._blend()
 
         @ti.kernel
         def _mark(self):
@@ -187,6 +225,71 @@ def blend_pressure_member(base):
                 i = self.state.spread(at)
                 self.free[i] = 1 if (self.state.kind[i] == FLUID
                                      and self.state.pressure[i] <= 0.0) else 0
+
+    return FreeMarkedStress
+
+
+def cumulative_pressure_member(base):
+    """``base`` (the member, with C4) with ``--surface cumulative``: after C4, a free-surface
+    particle also takes the w-weighted mean C4 pressure of its fluid neighbours outward of it
+    (r_ij . g_i < -|r_ij|/2, g pointing into the liquid), so the layer below the surface carries
+    the pull of the layer above as well as its own (the pressure summed from the outside in);
+    a third pass, tools only."""
+    from crowndemo.core.operators import weight
+    from crowndemo.core.state import FLUID
+
+    @ti.data_oriented
+    class CumulativePressureStress(free_marked_member(base)):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.p_own = ti.field(float, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._mark()
+            super().boundary_pressure()
+            self._keep()
+            self._cumulate()
+
+        @ti.kernel
+        def _keep(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.p_own[i] = self.state.pressure[i] if self.free[i] == 1 else 0.0
+
+        @ti.func
+        def _outward(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] == FLUID and self.free[j] == 1:
+                g = self.colour[i]
+                if rij.dot(g) < -0.5 * ti.sqrt(r2) * g.norm():
+                    w = weight(ti.sqrt(r2), self.coef.re[None])
+                    acc += ti.Vector([w * self.p_own[j], w])
+
+        @ti.kernel
+        def _cumulate(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                if self.free[i] == 1 and self.colour[i].norm() > 0.0:
+                    acc = ti.Vector([0.0, 0.0])
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._outward, acc)
+                    if acc[1] > 0.0:
+                        self.state.pressure[i] = self.p_own[i] + acc[0] / acc[1]
+
+    return CumulativePressureStress
+
+
+def blend_pressure_member(base):
+    """``base`` with ``--surface blend``: a free-surface particle (P = 0 after S17/M3) takes the
+    smaller of its pressurised neighbours' mean (``--surface neighbours``) and the normal stress
+    its own tension carries (``--surface own``, F = 1)."""
+    member = free_marked_member(neighbours_pressure_member(base))
+
+    @ti.data_oriented
+    class BlendPressureStress(member):
+        def boundary_pressure(self) -> None:
+            self._mark()
+            super().boundary_pressure()
+            self._blend()
 
         @ti.kernel
         def _blend(self):
@@ -203,7 +306,7 @@ def blend_pressure_member(base):
 def isotropic_core_member(base):
     """``base`` with the ``--isotropic-core`` pair (module docstring)."""
     from crowndemo.core.state import FLUID, GONE
-    from crowndemo.core.surface_tension.stress import stress_pair_kernel, stress_times
+    from crowndemo.core.surface_tension.stress import stress_times
 
     @ti.data_oriented
     class IsotropicCoreStress(base):
@@ -211,7 +314,7 @@ def isotropic_core_member(base):
         def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
             kind_j = self.state.kind[j]
             if kind_j != GONE:
-                fd = stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], self.coef.l0[None])
+                fd = self._pair_weight(ti.sqrt(r2))
                 if fd >= 0.0:
                     f = stress_times(self.colour[i], rij)
                     if kind_j == FLUID:
@@ -246,7 +349,7 @@ def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1) -> float
 def membrane_member(base, dim: int, ref: float):
     """``base`` with the ``--membrane`` pair (module docstring)."""
     from crowndemo.core.state import FLUID, GONE
-    from crowndemo.core.surface_tension.stress import stress_pair_kernel, stress_times
+    from crowndemo.core.surface_tension.stress import stress_times
     ratio = membrane_ratio(dim, ref)
 
     @ti.data_oriented
@@ -266,8 +369,7 @@ def membrane_member(base, dim: int, ref: float):
                         phi = ti.min(1.0, gi * l0 / ref) * ti.min(1.0, gj * l0 / ref)
                     elif gi + gj > 0.0:
                         phi = 2.0 * ti.min(gi, gj) / (gi + gj)
-                acc += ratio * phi * f * stress_pair_kernel(ti.sqrt(r2), self.coef.re[None],
-                                                            self.coef.l0[None])
+                acc += ratio * phi * f * self._pair_weight(ti.sqrt(r2))
 
     return MembraneStress
 
@@ -298,7 +400,7 @@ def lattice_virial_moment(dim: int, re_over_l0: float = 2.1) -> float:
     particle of a flat lattice face, in l0^2."""
     from crowndemo.core import lattice
     offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
-    fd = lattice.stress_pair_kernel(np.linalg.norm(offs, axis=1), re_over_l0)
+    fd = pair_kernel("quartic")(np.linalg.norm(offs, axis=1), re_over_l0)
     below = offs[:, -1] <= 1e-9
     return float(((offs[below, :-1] ** 2).sum(axis=1) * fd[below]).sum())
 
@@ -308,7 +410,6 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
     """``base`` with the ``--tangential-moment`` pass (module docstring); ``virial``: the
     ``--virial-moment`` one."""
     from crowndemo.core.state import FLUID, GONE
-    from crowndemo.core.surface_tension.stress import stress_pair_kernel
     if virial and kernel != "quartic":
         raise SystemExit("--virial-moment: with the member's pair kernel only")
     B0 = lattice_virial_moment(dim) if virial else lattice_moment(dim, beta, kernel=kernel)
@@ -335,7 +436,7 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
             if ti.static(kernel == "smooth"):
                 fd = smooth_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
             else:
-                fd = stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
+                fd = quartic_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
             moment = (r2 - rij.dot(n) ** 2) / (l0 * l0) * fd
             if ti.static(virial):
                 if self.state.kind[j] != GONE:
@@ -487,31 +588,67 @@ def smooth_pair_kernel(r, re, l0):
     return f
 
 
-def smooth_kernel_member(base, dim: int, name: str = "smooth"):
-    """``base`` with ``--pair-kernel smooth`` (or ``smooth2``): f_d = (1 - (r/h)^4)^2, h = re
-    (2 l0), the core below l0 as the member's, its K_d and a from the lattice
-    (pair_normalisers) in place of the member's."""
+@ti.func
+def quartic_pair_kernel(r, re, l0):
+    """The first member's f_d = 1 - (r/re)^4 (``--base first``, ``--pair-kernel quartic``),
+    times the core below l0."""
+    q = ti.min(r / re, 1.0)
+    f = 1.0 - q * q * q * q
+    if r < l0:
+        f *= (r / l0 - _stress.CORE) / (1.0 - _stress.CORE)
+    return f
+
+
+def kernel_ratio(dim: int, name: str) -> float:
+    """K_d a of the pair kernel ``name`` (pair_normalisers) over the member's (lattice.py):
+    the factor its pair weight takes in place of the member's."""
     from crowndemo.core import lattice
-    from crowndemo.core.state import FLUID, GONE
-    from crowndemo.core.surface_tension import stress
     Kd, a = pair_normalisers(dim, name)
+    return Kd * a / (lattice.stress_gradient_norm(dim, 1.0, 2.1, lattice.stress_pair_kernel,
+                                                  lattice.stress_pair_support(1.0))
+                     * lattice.stress_normaliser(dim, 1.0, 2.1))
+
+
+def kernel_member(base, dim: int, name: str):
+    """``base`` with ``--pair-kernel NAME``: the pair weight (stress._pair_weight) f_d of
+    PAIR_KERNELS[name], the core below l0 as the member's, its K_d and a from the lattice
+    (pair_normalisers) in place of the member's. "quartic" is the first member's
+    1 - (r/re)^4; the smooth ones (1 - (r/h)^4)^2 with h = re x PAIR_SUPPORT (smooth3: the
+    member's)."""
+    ratio = kernel_ratio(dim, name)
     h = PAIR_SUPPORT.get(name, 1.0)
-    ratio = Kd * a / (lattice.stress_gradient_norm(dim, 1.0, 2.1, lattice.stress_pair_kernel)
-                      * lattice.stress_normaliser(dim, 1.0, 2.1))
+    quartic = name == "quartic"
 
     @ti.data_oriented
-    class SmoothKernelStress(base):
+    class KernelStress(base):
         @ti.func
-        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
-            kind_j = self.state.kind[j]
-            if kind_j != GONE:
-                f = stress.stress_times(self.colour[i], rij)
-                if kind_j == FLUID:
-                    f += stress.stress_times(self.colour[j], rij)
-                acc += ratio * f * smooth_pair_kernel(ti.sqrt(r2), h * self.coef.re[None],
-                                                      self.coef.l0[None])
+        def _pair_weight(self, r):
+            f = 0.0
+            if ti.static(quartic):
+                f = quartic_pair_kernel(r, self.coef.re[None], self.coef.l0[None])
+            else:
+                f = smooth_pair_kernel(r, h * self.coef.re[None], self.coef.l0[None])
+            return ratio * f
 
-    return SmoothKernelStress
+    return KernelStress
+
+
+def zero_surface_member(base):
+    """``base`` without the member's free-surface pressure (C4): P = 0 there, as S17/M3 leave
+    it (the first member's; the --surface levers start from it)."""
+    @ti.data_oriented
+    class ZeroSurfaceStress(base):
+        def _surface_pressure(self) -> None:
+            pass
+
+    return ZeroSurfaceStress
+
+
+def first_member(dim: int):
+    """The first member (``--base first``, the figures of VALIDATION.md up to 2026-12-05):
+    f_d = 1 - (r/re)^4 and P = 0 on the free surface."""
+    from crowndemo.core.surface_tension.stress import StressTension
+    return kernel_member(zero_surface_member(StressTension), dim, "quartic")
 
 
 def _strip(s: float, beta: float, re: float, width: int, kernel: str):
@@ -602,17 +739,23 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("what", choices=("drop", "case", "stretch"))
     ap.add_argument("args", nargs="+")
+    ap.add_argument("--base", choices=("first", "member"), default="first",
+                    help="first: the first member (1 - (r/re)^4, P = 0 on the surface); "
+                         "member: the member as it is (stress.py)")
     ap.add_argument("--surface", choices=("zero", "neighbours", "virial", "own", "own-spacing",
-                                          "blend"),
-                    default="zero")
+                                          "blend", "eos", "cumulative"),
+                    default=None, help="the free surface's pressure (default: the base's)")
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--own-per-area", action="store_true")
+    ap.add_argument("--theta-slope", type=float, default=None,
+                    help="--surface eos: C in theta = 1 - C |g| l0 (default 0.72 2D, 0.62 3D)")
     ap.add_argument("--core", type=float, default=None)
     ap.add_argument("--isotropic-core", action="store_true")
     ap.add_argument("--tangential-moment", action="store_true")
     ap.add_argument("--virial-moment", action="store_true")
     ap.add_argument("--moment-clamp", type=float, default=4.0)
-    ap.add_argument("--pair-kernel", choices=tuple(PAIR_KERNELS), default="quartic")
+    ap.add_argument("--pair-kernel", choices=tuple(PAIR_KERNELS), default=None,
+                    help="the divergence's pair weight (default: the base's)")
     ap.add_argument("--membrane", action="store_true")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
@@ -622,7 +765,7 @@ def main() -> None:
     a = ap.parse_args()
     if a.what == "stretch":
         from crowndemo.core import Numerics
-        stretch(a.args[0], Numerics().free_surface_beta(2), a.pair_kernel)
+        stretch(a.args[0], Numerics().free_surface_beta(2), a.pair_kernel or "quartic")
         return
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
@@ -630,29 +773,34 @@ def main() -> None:
     from crowndemo.core import Numerics
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
-    member = stress.StressTension
+    dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+    member = first_member(dim) if a.base == "first" else stress.StressTension
+    if a.base == "member" and a.surface not in (None, "cumulative"):
+        member = zero_surface_member(member)
+    if a.surface == "cumulative" and a.base != "member":
+        raise SystemExit("--surface cumulative: --base member only (it builds on C4)")
+    kernel = a.pair_kernel or ("quartic" if a.base == "first" else "smooth3")
     if a.tangential_moment or a.virial_moment:
-        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+        if a.base != "first" or kernel not in ("quartic", "smooth"):
+            raise SystemExit("the moments: --base first, --pair-kernel quartic or smooth only")
         member = tangential_moment_member(member, Numerics().free_surface_beta(dim), dim,
                                           virial=a.virial_moment, clamp=a.moment_clamp,
-                                          kernel=a.pair_kernel)
-    if PAIR_SUPPORT.get(a.pair_kernel, 1.0) > 1.0:
-        raise SystemExit(f"--pair-kernel {a.pair_kernel}: stretch only (its support is beyond "
-                         "the walk's r*)")
-    if a.pair_kernel == "smooth2" and (a.tangential_moment or a.virial_moment):
-        raise SystemExit("--pair-kernel smooth2: not with the moments")
-    if a.pair_kernel in ("smooth", "smooth2"):
-        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+                                          kernel=kernel)
+    if a.pair_kernel is not None:
         if a.membrane or a.isotropic_core:
-            raise SystemExit("--pair-kernel smooth: not with --membrane or --isotropic-core")
-        member = smooth_kernel_member(member, dim, a.pair_kernel)
+            raise SystemExit("--pair-kernel: not with --membrane or --isotropic-core")
+        member = kernel_member(member, dim, a.pair_kernel)
     if a.membrane:
-        dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
         member = membrane_member(member, dim, a.membrane_ref)
     if a.isotropic_core:
         member = isotropic_core_member(member)
     if a.surface == "blend":
         member = blend_pressure_member(member)
+    elif a.surface == "cumulative":
+        member = cumulative_pressure_member(member)
+    elif a.surface == "eos":
+        slope = a.theta_slope if a.theta_slope is not None else (0.72 if dim == 2 else 0.62)
+        member = eos_pressure_member(member, slope)
     elif a.surface in ("neighbours", "virial"):
         member = neighbours_pressure_member(member, scaled=a.surface == "virial")
     elif a.surface in ("own", "own-spacing"):
