@@ -200,7 +200,7 @@ def test_plane_floor_is_no_free_surface(dim):
     from crowndemo.core.plane_floor import FLOOR_C, FLOOR_D, floor_tables
     re, h = 2.1 * L0, stress_pair_support(L0)
     # 111 samples from -l0/4 to H - l0/2 = 2.5 l0: every 0.025 l0, s = l0/2 and 3 l0/2 on it
-    s0, ds, table = floor_tables(dim, L0, re, wall_layers(2.1), samples=111)
+    s0, ds, table = floor_tables(dim, L0, re, wall_layers(2.1), samples=111, reach=h)
     for column, kernel, reach in ((FLOOR_C, stress_kernel, re), (FLOOR_D, stress_pair_kernel, h)):
         offs = lattice_offsets(dim, L0, reach)
         r = np.linalg.norm(offs, axis=1)

@@ -27,7 +27,7 @@ approach speed as against a wall particle (the collision model, terms.py).
 from __future__ import annotations
 
 import math
-from typing import Tuple
+from typing import Optional, Tuple
 
 import numpy as np
 import taichi as ti
@@ -38,16 +38,19 @@ SAMPLES = 1024
 FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C, FLOOR_D = 0, 1, 2, 3, 4
 
 
-def floor_tables(dim: int, l0: float, re: float, layers: int,
-                 samples: int = SAMPLES) -> Tuple[float, float, np.ndarray]:
+def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAMPLES,
+                 reach: Optional[float] = None) -> Tuple[float, float, np.ndarray]:
     """(s0, ds, table[samples, 5]): n_floor, g_floor (the component along the last axis),
     v_floor, c_floor and d_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
-    collision model has acted; the table holds its last value) to max(re, H) - l0/2 (beyond, no
-    floor point is within reach)."""
+    collision model has acted; the table holds its last value) to reach - l0/2 (beyond, no
+    floor point is within reach). ``reach``: the widest walk, re (the default) or, for the
+    surface stress, its pair support H (Model.wide_walk): d_floor is summed within H but
+    tabulated only as far as the walks reach."""
     h = stress_pair_support(l0)
-    s0, s1 = -0.25 * l0, max(re, h) - 0.5 * l0
+    reach = re if reach is None else reach
+    s0, s1 = -0.25 * l0, reach - 0.5 * l0
     ds = (s1 - s0) / (samples - 1)
-    m = int(math.ceil(max(re, h) / l0))
+    m = int(math.ceil(max(reach, re, h) / l0))
     lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
     lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
     lat2 = (lateral ** 2).sum(axis=1)
@@ -75,8 +78,10 @@ class PlaneFloor:
         self.inv_ds = ti.field(float, shape=())
         self.wall_depth = ti.field(float, shape=())    # the wall layer's plane: s = -l0/2
 
-    def set(self, dim: int, l0: float, re: float, layers: int) -> None:
-        s0, ds, table = floor_tables(dim, l0, re, layers)
+    def set(self, dim: int, l0: float, re: float, layers: int,
+            reach: Optional[float] = None) -> None:
+        """The tables for this spacing, to ``reach`` (floor_tables; re by default)."""
+        s0, ds, table = floor_tables(dim, l0, re, layers, reach=reach)
         self.s0[None] = s0
         self.inv_ds[None] = 1.0 / ds
         self.wall_depth[None] = 0.5 * l0

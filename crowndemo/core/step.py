@@ -213,7 +213,8 @@ class Simulator:
         hi = [min(v, big) for v in self.domain[1]]
         self.coef.set(physics, numerics, self.lattice, lo, hi)
         if self.floor is not None:
-            self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio))
+            self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio),
+                           reach=self.lattice.re * self.model.wide_walk)
         if self.symmetry is not None:
             self.symmetry.configure(self.lattice.re * self.model.wide_walk)
         self._lists_ready = False
