@@ -82,6 +82,29 @@ def test_flat_surface_feels_no_normal_force(sim2):
     assert np.abs(a).max() > 0.1 * scale
 
 
+def test_free_surface_pressure_is_zero_where_flat_and_positive_where_curved(sim2):
+    """C4: the free surface's pressure is the normal stress its own tension carries, so the top
+    of a lattice slab, flat, has none (no Laplace jump across a flat surface), while the
+    slab's corners, where the surface turns, are pressed in (P > 0); the slab's inside, at
+    n = n0, keeps the equation of state's P = 0."""
+    side = 40
+    pts = np.stack(np.meshgrid(np.arange(side) + 0.5, np.arange(6) + 0.5, indexing="ij"),
+                   -1).reshape(-1, 2) * L0
+    stress_acceleration(sim2, pts)
+    n = sim2.state.count
+    pos = sim2.state.pos.to_numpy()[:n].astype(float)
+    P = sim2.state.pressure.to_numpy()[:n].astype(float)
+    scale = SIGMA / L0                     # the pressure of a curvature of 1/l0
+    away = (pos[:, 0] > 4 * L0) & (pos[:, 0] < (side - 4) * L0)
+    top = pos[:, 1] > 5 * L0
+    assert (top & away).sum() >= 30
+    assert np.abs(P[top & away]).max() < 1e-4 * scale
+    corners = top & ~((pos[:, 0] > L0) & (pos[:, 0] < (side - 1) * L0))
+    assert corners.sum() == 2 and P[corners].min() > 0.05 * scale
+    inside = away & (pos[:, 1] > 2 * L0) & (pos[:, 1] < 4 * L0)
+    assert np.abs(P[inside]).max() < 1e-4 * scale
+
+
 def test_pair_forces_sum_to_zero(sim2):
     """Newton's third law: over a jittered cloud the forces of the member sum to zero
     against the sum of their sizes (float32 rounding)."""
