@@ -337,20 +337,23 @@ def membrane_weight(gi, gj, ref):
     return min(1.0, gi / ref) * min(1.0, gj / ref)
 
 
-def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1) -> float:
+def membrane_ratio(dim: int, ref: float = 0.0, re_over_l0: float = 2.1,
+                   kernel: str = "quartic") -> float:
     """a_membrane / a: the flat lattice face's normaliser a (lattice.stress_normaliser) with
     each pair's stress weighted by phi_ij (``membrane_weight``, ``membrane_member``), over the
-    member's a."""
-    f = pair_kernel("quartic")
-    return cut_sum(dim, f, re_over_l0) / cut_sum(
-        dim, f, re_over_l0, phi=lambda gi, gj: membrane_weight(gi, gj, ref))
+    base's a (pair weight ``kernel``: the first member's quartic, or the member's smooth3)."""
+    f = pair_kernel(kernel)
+    reach = re_over_l0 * max(PAIR_SUPPORT.get(kernel, 1.0), 1.0)
+    return cut_sum(dim, f, re_over_l0, reach) / cut_sum(
+        dim, f, re_over_l0, reach, phi=lambda gi, gj: membrane_weight(gi, gj, ref))
 
 
-def membrane_member(base, dim: int, ref: float):
-    """``base`` with the ``--membrane`` pair (module docstring)."""
+def membrane_member(base, dim: int, ref: float, kernel: str = "quartic"):
+    """``base`` with the ``--membrane`` pair (module docstring); ``kernel``: the base's pair
+    weight, for the ratio of normalisers."""
     from crowndemo.core.state import FLUID, GONE
     from crowndemo.core.surface_tension.stress import stress_times
-    ratio = membrane_ratio(dim, ref)
+    ratio = membrane_ratio(dim, ref, kernel=kernel)
 
     @ti.data_oriented
     class MembraneStress(base):
@@ -791,7 +794,7 @@ def main() -> None:
             raise SystemExit("--pair-kernel: not with --membrane or --isotropic-core")
         member = kernel_member(member, dim, a.pair_kernel)
     if a.membrane:
-        member = membrane_member(member, dim, a.membrane_ref)
+        member = membrane_member(member, dim, a.membrane_ref, kernel)
     if a.isotropic_core:
         member = isotropic_core_member(member)
     if a.surface == "blend":
