@@ -437,7 +437,7 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
             n = self.colour[i].normalized()
             fd = 0.0
             if ti.static(kernel == "smooth"):
-                fd = smooth_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
+                fd = _stress.stress_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
             else:
                 fd = quartic_pair_kernel(ti.sqrt(r2), self.coef.re[None], l0)
             moment = (r2 - rij.dot(n) ** 2) / (l0 * l0) * fd
@@ -581,17 +581,6 @@ def pair_normalisers(dim: int, name: str, re: float = 2.1) -> tuple:
 
 
 @ti.func
-def smooth_pair_kernel(r, re, l0):
-    """f_d = (1 - (r/re)^4)^2 (``--pair-kernel smooth``), times the member's core below l0."""
-    q = ti.min(r / re, 1.0)
-    f = 1.0 - q * q * q * q
-    f *= f
-    if r < l0:
-        f *= (r / l0 - _stress.CORE) / (1.0 - _stress.CORE)
-    return f
-
-
-@ti.func
 def quartic_pair_kernel(r, re, l0):
     """The first member's f_d = 1 - (r/re)^4 (``--base first``, ``--pair-kernel quartic``),
     times the core below l0."""
@@ -630,7 +619,7 @@ def kernel_member(base, dim: int, name: str):
             if ti.static(quartic):
                 f = quartic_pair_kernel(r, self.coef.re[None], self.coef.l0[None])
             else:
-                f = smooth_pair_kernel(r, h * self.coef.re[None], self.coef.l0[None])
+                f = _stress.stress_pair_kernel(r, h * self.coef.re[None], self.coef.l0[None])
             return ratio * f
 
     return KernelStress
