@@ -50,9 +50,15 @@ def row_reach(off: Iterable[int], k: float) -> int:
     return reach
 
 
+def cells_spanned(span: float) -> int:
+    """The whole cells a walk of ``span`` cells (fractional for the wide walk) covers on each
+    side of its own: ceil(span)."""
+    return int(math.ceil(span - 1e-9))
+
+
 def span_cells(cells_per_re: int, wide: float = 1.0) -> int:
     """The cells a walk to wide x re spans on each side of its own: ceil(k wide)."""
-    return int(math.ceil(cells_per_re * max(wide, 1.0) - 1e-9))
+    return cells_spanned(cells_per_re * max(wide, 1.0))
 
 
 def min_cells(dim: int, cells_per_re: int, wide: float = 1.0) -> int:
@@ -269,7 +275,7 @@ class CellGrid:
               span: ti.template()):
         """The stencil's rows for a walk radius of ``span`` cells of side re/reach."""
         d = ti.static(self.dim)
-        k = ti.static(int(math.ceil(span - 1e-9)))
+        k = ti.static(cells_spanned(span))
         c = self.cell_of(xi)
         h = self.side[None]
         stride = ti.Vector([1] * d)       # of the cell index along each axis
