@@ -27,7 +27,8 @@ examples:
 Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer,
 stress-laplace, stress-drop-oscillation (each -2d and -3d), stress-free-drop,
 crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. The stress- cases run the
-surface-stress model (method.md §4c) with the sum gradient form (stress-free-drop: -2d only). Each case runs
+surface-stress model (method.md §4c) with the sum gradient form (stress-free-drop: -2d only),
+their drops started off the lattice (variant lattice: on it). Each case runs
 at three resolutions in the base settings and, at the middle one, in its settings variants
 (--list says which case runs which):
   {variants}

@@ -12,6 +12,7 @@ from ..core.params import WATER, Numerics, Physics
 from .base import Scene, assemble, lattice_block
 
 COMPRESSION = 0.01   # the sound speed keeps the cohesion's compression ~1 % (see drop_sound_speed)
+DISORDER_SEED = 1    # the disordered start's random offsets: the same start every run
 
 
 def mode2_omega(dim: int, radius: float, sigma: float, rho: float) -> float:
@@ -25,6 +26,19 @@ def mode2_decay(dim: int, radius: float, nu: float) -> float:
     return (5.0 if dim == 3 else 4.0) * nu / radius ** 2
 
 
+def disordered(pts: np.ndarray, l0: float, amount: float,
+               seed: int = DISORDER_SEED) -> np.ndarray:
+    """The points each moved by independent offsets uniform in [-amount, amount] l0 along every
+    axis, from a seeded generator (the same start every run). A liquid's particles keep no
+    lattice; a ball cut from one is a crystal, whose pairs, pre-stressed by the Laplace
+    pressure, resist shear like a solid's and raised the stress model's 3D mode-2 frequency
+    6-12 % at R/l0 = 8-12 (VALIDATION.md, "A disordered start")."""
+    if amount <= 0.0:
+        return pts
+    rng = np.random.default_rng(seed)
+    return pts + amount * l0 * rng.uniform(-1.0, 1.0, pts.shape)
+
+
 def drop_sound_speed(l0: float, sigma: float, rho: float) -> float:
     """A sound speed at which the potential model's bulk cohesion, about 3 sigma/l0, compresses
     the liquid by ~COMPRESSION: c^2 rho COMPRESSION = 3 sigma / l0 (S17)."""
@@ -34,16 +48,17 @@ def drop_sound_speed(l0: float, sigma: float, rho: float) -> float:
 def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
                      amplitude: float = 0.1, periods: float = 2.0,
                      numerics: Optional[Numerics] = None, sound_speed: Optional[float] = None,
-                     **liquid) -> Scene:
+                     disorder: float = 0.0, **liquid) -> Scene:
     """A disc (ball) of radius R released with the velocity of its mode-2 oscillation of
     relative amplitude ``amplitude``: the potential phi = A (x^2 - y^2) in 2D,
     A (z^2 - (x^2 + y^2)/2) in 3D, with A = amplitude omega / 2, so that the surface moves as
-    R (1 + amplitude cos(2 theta) sin(omega t)) (P2 in 3D). Runs ``periods`` periods."""
+    R (1 + amplitude cos(2 theta) sin(omega t)) (P2 in 3D). Runs ``periods`` periods. The
+    particles sit on the lattice, or with ``disorder`` > 0 off it (``disordered``)."""
     liq = {**WATER, **liquid}
     omega = mode2_omega(dim, radius, liq["sigma"], liq["rho"])
     A = 0.5 * amplitude * omega
     pts = lattice_block([-radius] * dim, [radius] * dim, l0)
-    pts = pts[np.linalg.norm(pts, axis=1) <= radius]
+    pts = disordered(pts[np.linalg.norm(pts, axis=1) <= radius], l0, disorder)
     vel = np.zeros_like(pts)
     if dim == 2:
         vel[:, 0], vel[:, 1] = 2 * A * pts[:, 0], -2 * A * pts[:, 1]
@@ -55,6 +70,7 @@ def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
     period = 2 * math.pi / omega
     domain = (tuple([-4.0 * radius] * dim), tuple([4.0 * radius] * dim))
     info = {"scene": "oscillating drop", "radius_m": radius, "amplitude": amplitude,
+            "disorder_l0": disorder,
             "omega_rad_s": omega, "period_s": period,
             "decay_1_s": mode2_decay(dim, radius, liq["nu"]), "walls": []}
     return assemble("drop-oscillation", physics, numerics or Numerics(), pts, vel, None, domain,
@@ -63,10 +79,10 @@ def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
 
 def resting_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4, t_end: float = 0.01,
                  numerics: Optional[Numerics] = None, sound_speed: Optional[float] = None,
-                 **liquid) -> Scene:
+                 disorder: float = 0.0, **liquid) -> Scene:
     """A disc (ball) of radius R at rest without gravity: its inside pressure exceeds the
-    outside by sigma/R (2D), 2 sigma/R (3D)."""
+    outside by sigma/R (2D), 2 sigma/R (3D). ``disorder``: as ``oscillating_drop``'s."""
     sc = oscillating_drop(dim, radius, l0, amplitude=0.0, numerics=numerics,
-                          sound_speed=sound_speed, **liquid)
+                          sound_speed=sound_speed, disorder=disorder, **liquid)
     sc.info["scene"] = "resting drop"
     return replace(sc, name="resting-drop", t_end=t_end)

@@ -345,7 +345,8 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 # again for a setting another row checks (plane-floor: hydrostatic-2d; f64: shear-wave-2d),
 # which kept a first `--quick` (an empty Taichi cache) past 5 minutes (issue 26). Not in the
 # quick set: the crown's untrimmed film (11 times the particles) and its Courant limit on
-# relative speeds (another 3D model; the stability suite's -relative cases run it in 2D).
+# relative speeds (another 3D model; the stability suite's -relative cases run it in 2D), and
+# the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it).
 QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "dam-break-2d": "gradient=sum", "dam-break-3d": "safety/2",
                  "drop-oscillation-2d": "gradient=seed", "drop-oscillation-3d": "safety/2",
@@ -375,8 +376,15 @@ def all_cases(full: bool = True) -> Dict[str, Case]:
     return {c.name: c for c in cases}
 
 
+def variant_scene(variant: str) -> Dict[str, object]:
+    """The keyword arguments a settings variant passes to its case's run (its scene): the
+    crown's film not trimmed (``untrimmed``), the surface-stress drops on the lattice
+    (``lattice``; tension_cases.DISORDER)."""
+    return {"untrimmed": {"trim": False}, "lattice": {"disorder": 0.0}}.get(variant, {})
+
+
 def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
-    """The Numerics of a settings variant (precision and trimming are handled by the runner)."""
+    """The Numerics of a settings variant (its precision: the runner; its scene: variant_scene)."""
     if variant == "safety/2":
         return replace(numerics, courant=numerics.courant / 2, acoustic=numerics.acoustic / 2)
     if variant.startswith("gradient="):

@@ -109,7 +109,8 @@ def plot(rows: Sequence, path: str) -> Optional[str]:
         return "no run with a finite, positive error"
     fig, ax = plt.subplots(figsize=(10, 5.5))
     markers = {"f64": "s", "safety/2": "^", "gradient=sum": "D", "gradient=seed": "v",
-               "untrimmed": "P", "plane-floor": "<", "relative-courant": ">"}
+               "untrimmed": "P", "plane-floor": "<", "relative-courant": ">",
+               "lattice": "x"}
     styles = case_styles(cases)
     for name, rs in sorted(cases.items()):
         colour, line = styles[name]

@@ -10,7 +10,7 @@ from typing import Callable, Dict, Iterable, List, Optional
 from .. import backend
 from ..core import InstabilityError, Numerics
 from ..control import Session
-from .cases import Case, sharing, variant_numerics
+from .cases import Case, sharing, variant_numerics, variant_scene
 
 
 @dataclass
@@ -41,7 +41,7 @@ def run_one(case: Case, scale: float, variant: str = "base") -> Row:
     already be the variant's)."""
     l0 = case.l0_of(scale)
     numerics = variant_numerics(variant, case.base(Numerics()))
-    opts = {"trim": False} if variant == "untrimmed" else {}
+    opts = variant_scene(variant)
     t0 = time.perf_counter()
     try:
         res = case.run(l0, numerics, **opts)
