@@ -32,7 +32,7 @@ def disordered(pts: np.ndarray, l0: float, amount: float,
     axis, from a seeded generator (the same start every run). A liquid's particles keep no
     lattice; a ball cut from one is a crystal, whose pairs, pre-stressed by the Laplace
     pressure, resist shear like a solid's and raised the stress model's 3D mode-2 frequency
-    6-12 % at R/l0 = 8-12 (VALIDATION.md, "A disordered start")."""
+    6-11 % at R/l0 = 8-12 (VALIDATION.md, "A disordered start for the 3D drops")."""
     if amount <= 0.0:
         return pts
     rng = np.random.default_rng(seed)
