@@ -90,7 +90,8 @@ def _preset_facts(r, tp) -> Dict:
         "compile_seconds": est["compile_seconds"],
         "crown_cost": {"before_contact": est["crown_cost_calm"],
                        "after_contact": est["crown_cost_splash"],
-                       "wall_or_dummy": estimate.WALL_COST},
+                       "wall_or_dummy": estimate.WALL_COST,
+                       "surface_tension_model": est["surface_tension_cost"]},
         "throughput": {"fluid_particle_steps_per_s": tp.rate,
                        "all_particle_steps_per_s": tp.rate_total,
                        "bytes_per_particle": tp.bytes_per_particle, "source": tp.source},
@@ -101,6 +102,15 @@ def _preset_facts(r, tp) -> Dict:
                               crown_base_radius(s["t_end"] - impact, U, D, h)},
         "left_out": est["particles"]["left_out"],
     }
+
+
+def _model_cost(r, cost: dict) -> str:
+    """', the stress model's passes included (1.9 x the potential's)' where the member costs
+    other than the seed's potential (estimate.SURFACE_TENSION_COST), else ''."""
+    if cost["surface_tension_model"] == 1.0:
+        return ""
+    return (f", the {r.model.surface_tension_model} model's passes included "
+            f"({cost['surface_tension_model']:g} x the potential's)")
 
 
 def _speed_in_c(v: float, c: float, U: float) -> str:
@@ -220,8 +230,8 @@ def info_preset(args) -> int:
     print(f"  run time    ~{estimate.human_seconds(f['run_seconds_estimate'])} on the CPU of "
           f"BENCHMARKS.md (at least {estimate.human_seconds(f['run_seconds_at_U'])}): "
           f"{tp.rate:.3g} fluid particle-steps/s (the bench), a crown step costing "
-          f"{cost['before_contact']:g} of it a fluid particle before contact and "
-          f"{cost['after_contact']:.3g} after (a wall or dummy particle "
+          f"{cost['before_contact']:.3g} of it a fluid particle before contact and "
+          f"{cost['after_contact']:.3g} after{_model_cost(r, cost)} (a wall or dummy particle "
           f"{cost['wall_or_dummy']:g} of a fluid one), + {f['compile_seconds']:g} s compiling "
           f"(a first run; 3-9 s with the kernels in Taichi's cache)")
     left = f["left_out"] or ["nothing"]

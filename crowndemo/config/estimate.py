@@ -63,6 +63,12 @@ SPLASH_COST = 1.70           # ... after contact at D/l0 = SPLASH_COST_AT (measu
 SPLASH_COST_AT = 100.0
 SPLASH_COST_GROWTH = 0.55    # ... times (D/l0 / SPLASH_COST_AT)^this (0.93 at D/l0 = 33)
 WALL_COST = 0.25             # a wall or dummy particle-step / a fluid one (measured)
+# A crown step's cost with each surface-tension model / the seed's potential's: the booth
+# 3m-drop timed whole, one run after the other, nothing else running (BENCHMARKS.md "The
+# surface-tension models' cost", 2026-12-05): 0.1365 s a step with the potential (0.1353 with
+# the sum form: the form costs nothing), 0.3724 with the stress member and the sum form (its
+# two passes, the pair pass walking to 3 l0, method.md §4c), 0.1714 with the curvature model.
+SURFACE_TENSION_COST = {"potential": 1.0, "stress": 2.75, "curvature": 1.26}
 # A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
 # (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
 # 2026-11-23, this CPU): 4.9 s in 2D, 51.5 s in 3D (13-19 s with --fast-compile, BENCHMARKS.md
@@ -247,23 +253,26 @@ def steps_to_end(r: Resolved) -> Dict:
             "steps_before_contact": int(calm)}
 
 
-def crown_cost(drop_over_l0: float, splashing: bool) -> float:
+def crown_cost(drop_over_l0: float, splashing: bool,
+               surface_tension: str = "potential") -> float:
     """A crown step's cost per fluid particle / the bench's: CALM_COST before contact,
-    SPLASH_COST x (D/l0 / SPLASH_COST_AT)^SPLASH_COST_GROWTH after it (module docstring)."""
+    SPLASH_COST x (D/l0 / SPLASH_COST_AT)^SPLASH_COST_GROWTH after it (module docstring),
+    times the surface-tension model's SURFACE_TENSION_COST."""
+    model = SURFACE_TENSION_COST[surface_tension]
     if not splashing:
-        return CALM_COST
-    return SPLASH_COST * (max(drop_over_l0, 1.0) / SPLASH_COST_AT) ** SPLASH_COST_GROWTH
+        return CALM_COST * model
+    return model * SPLASH_COST * (max(drop_over_l0, 1.0) / SPLASH_COST_AT) ** SPLASH_COST_GROWTH
 
 
 def run_seconds(counts: Dict, calm_steps: int, splash_steps: int, tp: Throughput, dim: int,
-                drop_over_l0: float) -> float:
+                drop_over_l0: float, surface_tension: str = "potential") -> float:
     """A first run's compile (FIRST_RUN_COMPILE_S) + the steps before and after contact, each
     costing (fluid + WALL_COST x (wall + dummy)) particles at the bench's rate per fluid
-    particle times ``crown_cost`` of its phase. 2D steps are taken to cost the 3D rate per
-    particle (an upper figure: a 2D particle has fewer neighbours)."""
+    particle times ``crown_cost`` of its phase and surface-tension model. 2D steps are taken
+    to cost the 3D rate per particle (an upper figure: a 2D particle has fewer neighbours)."""
     weighted = counts["fluid"] + WALL_COST * (counts.get("wall", 0) + counts.get("dummy", 0))
-    work = (calm_steps * crown_cost(drop_over_l0, False)
-            + splash_steps * crown_cost(drop_over_l0, True))
+    work = (calm_steps * crown_cost(drop_over_l0, False, surface_tension)
+            + splash_steps * crown_cost(drop_over_l0, True, surface_tension))
     return FIRST_RUN_COMPILE_S[dim] + weighted * work / tp.rate
 
 
@@ -276,16 +285,19 @@ def summary(r: Resolved, tp: Throughput, exact_up_to: float = EXACT_UP_TO) -> Di
     counts = particle_counts(r, exact_up_to)
     st = steps_to_end(r)
     d_l0 = r.scene["drop"] / r.l0
+    # the member compiled in (sigma > 0); with none the potential's figures stand
+    tension = r.model.surface_tension_model if r.model.surface_tension else "potential"
     calm = st["steps_before_contact"]
-    secs = run_seconds(counts, calm, st["steps"] - calm, tp, r.dim, d_l0)
-    cost_calm, cost_splash = crown_cost(d_l0, False), crown_cost(d_l0, True)
+    secs = run_seconds(counts, calm, st["steps"] - calm, tp, r.dim, d_l0, tension)
+    cost_calm, cost_splash = crown_cost(d_l0, False, tension), crown_cost(d_l0, True, tension)
     # a floor: the fewest steps, each in the phase that costs less
     fewest = st["steps_at_U"]
     floor_steps = (fewest, 0) if cost_calm <= cost_splash else (0, fewest)
     return {"particles": counts, **st, "run_seconds": secs, "compile_seconds":
             FIRST_RUN_COMPILE_S[r.dim],
-            "run_seconds_at_U": run_seconds(counts, *floor_steps, tp, r.dim, d_l0),
+            "run_seconds_at_U": run_seconds(counts, *floor_steps, tp, r.dim, d_l0, tension),
             "crown_cost_calm": cost_calm, "crown_cost_splash": cost_splash,
+            "surface_tension_cost": SURFACE_TENSION_COST[tension],
             "memory_bytes": memory_bytes(counts["total"], tp)}
 
 
