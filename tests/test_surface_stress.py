@@ -291,3 +291,24 @@ def test_block_on_the_plane_floor_has_no_surface_at_the_floor():
     bottom = pos[:, 1] < pos[:, 1].min() + 0.5 * L0
     assert (bottom & away).sum() >= 20
     assert np.abs(a[bottom & away]).max() < 1e-4 * scale
+
+
+def test_thrown_out_particles_leave_the_drops_moments():
+    """validate/tension_cases.drop_particles: a ball's mode-2 deformation is zero by symmetry;
+    one particle thrown out to 3 R adds (3 R)^2/N to <z^2>, more than the mode's own moment at
+    amplitude 0.1 (2/5 R^2 x 0.3 = 0.12 R^2 for a uniform ball, over N ~ 2,000 particles
+    ~6e-5 R^2 a particle), so the watch leaves it out, and a particle gone from the domain too."""
+    from crowndemo.core.state import GONE
+    from crowndemo.validate import oscillation
+    from crowndemo.validate.tension_cases import R, drop_particles
+    l0 = R / 8
+    ax = np.arange(-R + l0 / 2, R, l0)
+    ball = np.stack(np.meshgrid(ax, ax, ax, indexing="ij"), -1).reshape(-1, 3)
+    ball = ball[(ball * ball).sum(axis=1) < R * R]
+    pos = np.vstack([ball, [[0.0, 0.0, 3 * R], [0.0, 0.0, -2 * R]]])
+    kind = np.full(len(pos), FLUID)
+    kind[-1] = GONE
+    assert abs(oscillation.deformation(pos[:-1])) > (3 * R) ** 2 / len(pos) / 2
+    keep = drop_particles(pos, kind)
+    assert keep.sum() == len(ball) and keep[: len(ball)].all()
+    assert oscillation.deformation(pos[keep]) == pytest.approx(0.0, abs=1e-12 * R * R)
