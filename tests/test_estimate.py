@@ -90,4 +90,5 @@ def test_info_names_the_surface_tension_models_cost(capsys):
     from crowndemo.cli import main
     assert main(["info", "2m-drop", "--set", "numerics.surface_tension=stress"]) == 0
     cost = estimate.SURFACE_TENSION_COST["stress"]
-    assert f"the stress model's passes included ({cost:g} x the potential's)" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert f"the stress model's passes included ({cost:g} x the potential's)" in out

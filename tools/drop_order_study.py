@@ -2,19 +2,18 @@
 run with a watch on the lattice it started from (VALIDATION.md, "A disordered start for the 3D
 drops"; issue 23):
 
-    .venv/bin/python tools/drop_order_study.py R/l0[,R/l0...] [--disorder A]
-                                               [--periods P] [--amplitude A] [--nu NU] [--threads N]
-                                               [--numerics KEY=VALUE ...]
+    .venv/bin/python tools/drop_order_study.py R/l0[,R/l0...] [--disorder A] [--periods P]
+                          [--amplitude A] [--nu NU] [--threads N] [--numerics KEY=VALUE ...]
 
 Per frame (every 1/8 period printed): the mode-2 deformation of the drop's own particles
 (tension_cases.drop_particles), the particles thrown out of it, the cubic order of the
 particles at r < R - 2 l0 (over their bonds shorter than 1.25 l0, the mean of (x^4 + y^4 +
 z^4)/r^4 of the bond, mapped so that 1 is the start lattice's six axis bonds and 0 bonds
-pointing every way (3/5); a local measure, blind to the drop's own strain), the centre of mass's distance from its start over R, and the total momentum over
-(N U_ref), U_ref the start's largest speed (a pair force cannot change it; it changes where a
-particle leaves the domain) and the largest speed over U_ref. At the end the
-frequency and decay fitted as the case fits them, and from the second period on, against
-Rayleigh and Lamb."""
+pointing every way (3/5); a local measure, blind to the drop's own strain), the centre of
+mass's distance from its start over R, the total momentum over (N U_ref), U_ref the start's
+largest speed (a pair force cannot change it; it changes where a particle leaves the domain),
+and the largest speed over U_ref. At the end the frequency and decay fitted as the case fits
+them, and from the second period on, against Rayleigh and Lamb."""
 import argparse
 import math
 import time

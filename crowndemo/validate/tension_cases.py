@@ -27,10 +27,11 @@ FORM = "sum"               # the drops' gradient form (module docstring)
 # The 3D drops start off the lattice (scenes/drop.py ``disordered``), their particles moved by
 # up to DISORDER l0 along each axis: a ball cut from the lattice is a crystal that resists
 # shear (the 3D mode-2 frequency 6-11 % high on the lattice at R/l0 = 8-12, 1-5 % off it;
-# VALIDATION.md "A disordered start for the 3D drops"); 0.25 l0 set pairs so close that the 3D drops at R/l0 = 10 and 12 blew
-# apart. The variant ``lattice`` runs the lattice start. The 2D drops keep the lattice: from
-# 0.15 l0 off it the resting and oscillating drops threw over 5 % of their particles out at
-# R/l0 = 12 and 16 (the oscillating one at 8 too), and the free drop at 8 drifted 0.76 R.
+# VALIDATION.md "A disordered start for the 3D drops"); 0.25 l0 set pairs so close that the
+# 3D drops at R/l0 = 10 and 12 blew apart. The variant ``lattice`` runs the lattice start.
+# The 2D drops keep the lattice: from 0.15 l0 off it the resting and oscillating drops threw
+# over 5 % of their particles out at R/l0 = 12 and 16 (the oscillating one at 8 too), and the
+# free drop at 8 drifted 0.76 R.
 DISORDER = {2: 0.0, 3: 0.15}
 
 
@@ -81,9 +82,10 @@ class DropWatch:
     def __call__(self, sim, index: int) -> None:
         sim.refresh_pressure()
         snap = sim.snapshot()
-        keep = drop_particles(snap["pos"].astype(float), snap["kind"])
+        pos = snap["pos"].astype(float)
+        keep = drop_particles(pos, snap["kind"])
         self.ejected.append(int(len(keep) - keep.sum()))
-        p, v = snap["pos"][keep].astype(float), snap["vel"][keep].astype(float)
+        p, v = pos[keep], snap["vel"][keep].astype(float)
         c = p.mean(axis=0)
         d = p - c
         r2 = (d * d).sum(axis=1)
