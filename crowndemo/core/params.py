@@ -19,6 +19,10 @@ SURFACE_TENSION_MODELS = ("potential", "stress", "curvature")
 # the surface stress's divergence pair kernel reaches STRESS_PAIR_SUPPORT l0 (method.md C3):
 # beyond re = 2.1 l0, so its walk is the grid's wide one (grid.py)
 STRESS_PAIR_SUPPORT = 3.0
+# the surface stress's curvature correction sigma (1 - delta H) (method.md C5): delta, per
+# dimension, in l0; the surface of tension sits inside the liquid's surface in 3D drops
+# (VALIDATION.md, "The curvature correction"); 0 compiles it out
+STRESS_TOLMAN = {2: 0.0, 3: 0.92}
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m

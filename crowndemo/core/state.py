@@ -46,6 +46,7 @@ class ParticleState:
         self.threads = _cpu_threads()
         self.chunks_per_thread = ti.field(ti.i32, shape=())    # see spread
         self._persistent: Dict[str, ti.Field] = {}
+        self._carried: Dict[str, ti.Field] = {}       # members' fields: see ``carry``
         self.pos = self._register("pos", ti.Vector.field(dim, float, self.capacity))
         self.vel = self._register("vel", ti.Vector.field(dim, float, self.capacity))
         self.pressure = self._register("pressure", ti.field(float, self.capacity))
@@ -60,6 +61,13 @@ class ParticleState:
 
     def _register(self, name: str, f):
         self._persistent[name] = f
+        return f
+
+    def carry(self, name: str, f: ti.Field) -> ti.Field:
+        """A model member's per-particle field that lasts from one step to the next (the
+        surface stress's lagged curvature factor): permuted with the persistent fields and
+        saved by ``dump``, not in snapshots; a checkpoint without it leaves it as it is."""
+        self._carried[name] = f
         return f
 
     @property
@@ -128,7 +136,8 @@ class ParticleState:
         """Every persistent field in storage order, the first n entries: with ``restore`` a
         run continues exactly as if it had not stopped."""
         n = self.count
-        return {name: f.to_numpy()[:n] for name, f in self._persistent.items()}
+        return {name: f.to_numpy()[:n] for name, f in {**self._persistent,
+                                                       **self._carried}.items()}
 
     def restore(self, arrays: Dict[str, np.ndarray]) -> None:
         """Put back what ``dump`` returned; the slots beyond n become GONE."""
@@ -138,7 +147,9 @@ class ParticleState:
         n = len(arrays["kind"])
         if n > self.capacity:
             raise ValueError(f"{n} particles exceed the capacity {self.capacity}")
-        for name, f in self._persistent.items():
+        for name, f in {**self._persistent, **self._carried}.items():
+            if name not in arrays:         # a carried field an older checkpoint lacks
+                continue
             full, a = f.to_numpy(), np.asarray(arrays[name])
             if a.shape != (n,) + full.shape[1:] or a.dtype != full.dtype:
                 raise ValueError(f"particle field {name}: {a.dtype}{list(a.shape)} does not fit "
@@ -153,7 +164,7 @@ class ParticleState:
     # ---- the one permutation of every persistent field -----------------------------------
     def permute(self, order: ti.Field) -> None:
         """Field[k] <- Field[order[k]] for k < n, for every persistent field."""
-        for f in self._persistent.values():
+        for f in list(self._persistent.values()) + list(self._carried.values()):
             scratch = (self.scratch_vec if isinstance(f, ti.MatrixField)
                        else self.scratch_int if f.dtype == ti.i32 else self.scratch_float)
             self._gather(f, scratch, order)

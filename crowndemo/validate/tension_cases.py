@@ -146,16 +146,23 @@ def _laplace(dim: int) -> Case:
 
 
 def _oscillation(dim: int) -> Case:
-    nu, periods = 1.0e-5, 3.0
+    nu, fitted = 1.0e-5, 3.0
 
     def run(l0: float, numerics: Numerics, disorder: float = DISORDER[dim]) -> Outcome:
+        # a disordered start is a lattice that melts in its first period, oscillating slower
+        # while it does (VALIDATION.md, "The 3D oscillating drop's thrown-out particles"): the
+        # fit starts after it; a start on the lattice is fitted from t = 0
+        melt = 1.0 if disorder > 0 else 0.0
+        periods = melt + fitted
         scene = oscillating_drop(dim=dim, radius=R, l0=l0, nu=nu, periods=periods,
                                  numerics=numerics, disorder=disorder)
         sim = simulator(scene)
         watch = DropWatch(dim)
         sim.run(scene.t_end, frame_times=np.linspace(0, scene.t_end, int(40 * periods) + 1),
                 on_frame=watch)
-        omega, decay = oscillation.fit(watch.t, watch.deformation)
+        t = np.asarray(watch.t)
+        after = t >= melt * 2.0 * math.pi / scene.info["omega_rad_s"] - 1e-12
+        omega, decay = oscillation.fit(t[after], np.asarray(watch.deformation)[after])
         ref, ref_decay = scene.info["omega_rad_s"], scene.info["decay_1_s"]
         err = abs(omega / ref - 1) if math.isfinite(omega) else math.inf
         return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay,

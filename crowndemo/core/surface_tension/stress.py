@@ -7,8 +7,8 @@ tensor (Lafaurie et al., J. Comput. Phys. 113, 1994; in SPH Hu & Adams, J. Compu
 with g the gradient of the liquid's colour (1 in the liquid, 0 outside). T is a tension along
 the surface layer with no normal component: on a flat surface its divergence vanishes, on a
 curved one it sums to sigma kappa n over the layer, the Young-Laplace jump, with no curvature
-computed. Two neighbour passes at r*, after the number density (S17), and the free surface's
-pressure:
+computed. Two neighbour passes at r*, after the number density (S17), the free surface's
+pressure and, in 3D, a curvature correction:
 
 1. the colour gradient (C1), g_i = omega_i K sum_j r_ij f(r_ij) over every neighbour kind,
    f(r) = (1 - r/re)^3 (a Wendland C2 kernel's gradient: bounded where the MPS w/r^2 is not;
@@ -22,7 +22,7 @@ pressure:
    flat lattice surface carry exactly sigma (lattice.stress_normaliser);
 2. the divergence in the sum form (C3),
    a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij),  f_d(r) = (1 - (r/H)^4)^2, H = 3 l0,
-   T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d. Each pair's terms are equal
+   T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d (each T times C5's s). Each pair's terms are equal
    and opposite (for a fluid j), so the model conserves momentum exactly: a free drop cannot
    drift by its own surface tension. f_d is zero with zero slope at H, beyond the lattice's
    pairs at 2 l0, so the tension a surface carries hardly depends on how closely its outer
@@ -46,7 +46,19 @@ pressure:
    at R/l0 = 8-16, the virial, VALIDATION.md), and the first member's 3D drops read 42-59 %
    high; with C4 the surface layer carries it. The factor 1 is the flat lattice face's
    balance: the sum form's push of a uniform pressure on a face particle, 2 P G/n0 d, equals
-   its own pull at F = n0/(2 d G) = 1.016 (2D) / 1.011 (3D). It needs no pass: a_i is pass 2's.
+   its own pull at F = n0/(2 d G) = 1.016 (2D) / 1.011 (3D). It needs no pass: a_i is pass 2's;
+4. the curvature correction (C5): particle i's tension T_i is taken s_i = clamp(1 - delta l0
+   H_i, 1/2, 3/2) times, H_i the mean curvature from the divergence of the unit normals n =
+   g/|g| over its neighbours within re, H_i = -sum_j (n_j - n_i) . r_ij f / sum_j |r_t|^2 f
+   (r_t: r_ij's part in i's tangent plane; 1/r on a sphere or circle of radius r). In a 3D
+   drop the pull lands about a spacing inside the liquid's surface and the inside pressure
+   read 2 sigma/(R - 0.9 l0) (+17 / +8 / +5 % at R/l0 = 8 / 12 / 16), and the mode-2
+   frequency as high: a surface of tension delta inside the liquid's, as Tolman's (1949) for a
+   real liquid, sigma (1 - delta H) moving it back out. delta = params.STRESS_TOLMAN (l0): 0.92
+   in 3D, from the member's +8.27 % at R/l0 = 12; 0 in 2D (compiled out), whose drops read
+   +4 / +2 / 0 % without it. H_i is summed in pass 2's walk and used in the next step's pass 2
+   (s_i lags a step, a carried field, so no third pass); the pairs stay antisymmetric, as
+   (s_i T_i + s_j T_j) r_ij f_d.
 
 The acceleration is applied in the corrector with the pressure gradient (S18-S20), at r*.
 ``_pair_weight`` and ``_surface_pressure`` are the member's two choices (C3's f_d, C4), each a
@@ -58,10 +70,11 @@ import taichi as ti
 
 from ..coefficients import Coefficients
 from ..grid import CellGrid
-from ..params import STRESS_PAIR_SUPPORT, Model
+from ..params import STRESS_PAIR_SUPPORT, STRESS_TOLMAN, Model
 from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
+TOLMAN_CLAMP = (0.5, 1.5)    # s_i's range (C5): a lone or spray particle's H is no curvature
 
 
 @ti.func
@@ -106,6 +119,13 @@ class StressTension:
         self.colour = ti.Vector.field(self.dim, float, cap)   # g_i (C1) [1/m]
         self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
         self.floor = None        # the analytic plane floor, where the model has one
+        # C5: sigma (1 - delta H), delta in l0 (params.STRESS_TOLMAN); s_i lags one step
+        self.delta = STRESS_TOLMAN[self.dim]
+        self.tolman = self.state.carry("stress_tolman", ti.field(float, cap))    # s_i
+        self.tolman_next = ti.field(float, cap)                                 # s_i, next
+        self.tolman.fill(1.0)
+        self.pass_sums = ti.types.struct(a=ti.types.vector(self.dim, float), h_num=float,
+                                         h_den=float)    # pass 2's: a_i and C5's H_i
         self.symmetry = None     # the mirror planes, where the scene has them
 
     def attach(self, floor, symmetry) -> None:
@@ -113,7 +133,8 @@ class StressTension:
         self.floor, self.symmetry = floor, symmetry
 
     def nbytes(self) -> int:
-        return field_nbytes(self.colour) + field_nbytes(self.accel)
+        return (field_nbytes(self.colour) + field_nbytes(self.accel)
+                + field_nbytes(self.tolman) + field_nbytes(self.tolman_next))
 
     def boundary_pressure(self) -> None:
         """The two passes (module docstring), then the free surface's pressure (C4)."""
@@ -152,10 +173,11 @@ class StressTension:
 
     @ti.kernel
     def _sync_images(self):
-        """Images take their sources' g, reflected across their planes."""
+        """Images take their sources' g, reflected across their planes, and their s (C5)."""
         n = self.state.n[None]
         for s in range(n, n + self.state.n_images[None]):
             self.colour[s] = self.symmetry._mirrored(self.colour[self.symmetry.source[s]], s)
+            self.tolman[s] = self.tolman[self.symmetry.source[s]]
 
     @ti.func
     def _pair_weight(self, r):
@@ -167,10 +189,27 @@ class StressTension:
     def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
         kind_j = self.state.kind[j]
         if kind_j != GONE:
-            f = stress_times(self.colour[i], rij)
+            r = ti.sqrt(r2)
+            gi, gj = self.colour[i], self.colour[j]
+            f = stress_times(gi, rij) * self._tension(i)
             if kind_j == FLUID:
-                f += stress_times(self.colour[j], rij)
-            acc += f * self._pair_weight(ti.sqrt(r2))
+                f += stress_times(gj, rij) * self._tension(j)
+            acc.a += f * self._pair_weight(r)
+            if ti.static(self.delta > 0.0):
+                if r < self.coef.re[None] and gj.norm() > 0.0 and gi.norm() > 0.0:
+                    ni = gi.normalized()          # C5's sums: the divergence of n = g/|g|
+                    rt = rij - rij.dot(ni) * ni
+                    w = stress_kernel(r, self.coef.re[None])
+                    acc.h_num += (gj.normalized() - ni).dot(rij) * w
+                    acc.h_den += rt.dot(rt) * w
+
+    @ti.func
+    def _tension(self, i):
+        """s_i of C5 (1 where the correction is compiled out)."""
+        s = 1.0
+        if ti.static(self.delta > 0.0):
+            s = self.tolman[i]
+        return s
 
     @ti.kernel
     def _divergence(self):
@@ -179,16 +218,24 @@ class StressTension:
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
         reach2 = (STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2      # H^2: the wide walk
+        lo, hi = ti.static(TOLMAN_CLAMP)
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
+            s_next = 1.0
             if self.state.kind[i] == FLUID:
-                acc = ti.Vector.zero(float, self.dim)
+                acc = self.pass_sums(a=ti.Vector.zero(float, self.dim), h_num=0.0, h_den=0.0)
                 self.grid.for_each_wide(i, self.state.pos[i], reach2, self._divergence_pair, acc)
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
                     ez[self.dim - 1] = self.floor.divergence_at(self.state.pos[i][self.dim - 1])
-                    acc += stress_times(self.colour[i], ez)
-                self.accel[i] = scale * acc
+                    acc.a += stress_times(self.colour[i], ez) * self._tension(i)
+                self.accel[i] = scale * acc.a
+                if ti.static(self.delta > 0.0):
+                    if acc.h_den > 0.0:     # H_i = -sum (n_j - n_i).r_ij f / sum |r_t|^2 f (C5)
+                        h = -acc.h_num / acc.h_den
+                        s_next = ti.min(ti.max(1.0 - self.delta * self.coef.l0[None] * h, lo), hi)
+            if ti.static(self.delta > 0.0):
+                self.tolman_next[i] = s_next
 
     @ti.kernel
     def _surface_pressure(self):
@@ -201,6 +248,8 @@ class StressTension:
             gl = g.norm()
             if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and gl > 0.0:
                 self.state.pressure[i] = scale * ti.max(self.accel[i].dot(g) / gl, 0.0)
+            if ti.static(self.delta > 0.0):
+                self.tolman[i] = self.tolman_next[i]      # C5: the next step's s_i
 
     @ti.func
     def acceleration(self, i):
