@@ -8,6 +8,7 @@ layer does" and after, issue 23), reproducible:
                           [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
+                          [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
 
@@ -16,7 +17,8 @@ layer does" and after, issue 23), reproducible:
 the member's two hooks, stress._pair_weight and stress._surface_pressure; its runs agree with
 the tables within the drops' run-to-run scatter, ~1 %, not to the digit). ``--base member``:
 the member as stress.py has it (f_d = (1 - (r/H)^4)^2, H = 3 l0, and the free surface's own
-normal stress, C4). ``--surface`` and ``--pair-kernel`` replace the base's choice.
+normal stress, C4, and in 3D the curvature correction C5). ``--surface`` and ``--pair-kernel``
+replace the base's choice.
 
 ``drop``: a resting drop (R = 1 mm, nu = 1e-4, the sum form) run for T_MS ms; every 0.5 ms the
 inside pressure (EOS, r < R/2) against Young-Laplace, the total radial tension force against the
@@ -59,6 +61,11 @@ M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat
 (|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
 the tension acts between surface particles only (an inner particle, g = 0, takes none of the
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
+``--tolman DELTA``: C5's delta (stress.py; params.STRESS_TOLMAN) for the run's dimension, 0
+for the member before C5 (``--base first`` runs without C5 unless given); ``--tolman-pass
+DELTA``: the study that led to C5 (C5 off): s_i from this step's normals in a third pass
+between pass 1 and pass 2 (tolman_member), with ``--tolman-fit`` H_i from the curvature
+member's surface fit instead of the normals' divergence (tolman_fit_member).
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
 ``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
 same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
@@ -625,6 +632,124 @@ def kernel_member(base, dim: int, name: str):
     return KernelStress
 
 
+def tolman_member(base, delta: float):
+    """``base`` with ``--tolman-pass DELTA`` (the study that led to C5, with C5 itself off):
+    each free-surface particle's tension (its g, so T_i)
+    times s_i = clamp(1 - DELTA l0 H_i, 1/2, 3/2), H_i the mean curvature from the unit
+    normals n = g/|g| of its neighbours, H_i = -sum_j (n_j - n_i) . r_ij f / sum_j |r_t|^2 f
+    (r_t: r_ij's part in i's tangent plane; 1/r on a sphere or a circle of radius r): a
+    Tolman-like correction sigma (1 - delta H) for a surface of tension that sits DELTA l0
+    inside the liquid's. A third pass between pass 1 and pass 2; the pairs stay antisymmetric."""
+    from crowndemo.core.state import FLUID, GONE
+
+    @ti.data_oriented
+    class TolmanStress(base):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.tolman = ti.field(float, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._colour()
+            if self.symmetry is not None:
+                self._sync_images()
+            self._curvature()
+            self._apply()
+            if self.symmetry is not None:
+                self._sync_images()
+            self._divergence()
+            self._surface_pressure()
+
+        @ti.func
+        def _curvature_pair(self, i, j, rij, r2, acc: ti.template()):
+            gj = self.colour[j]
+            if self.state.kind[j] != GONE and gj.norm() > 0.0:
+                ni = self.colour[i].normalized()
+                f = _stress.stress_kernel(ti.sqrt(r2), self.coef.re[None])
+                rt = rij - rij.dot(ni) * ni
+                acc[0] += (gj.normalized() - ni).dot(rij) * f
+                acc[1] += rt.dot(rt) * f
+
+        @ti.kernel
+        def _curvature(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                s = 1.0
+                if self.state.kind[i] == FLUID and self.colour[i].norm() > 0.0:
+                    acc = ti.Vector([0.0, 0.0])
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._curvature_pair, acc)
+                    if acc[1] > 0.0:
+                        h = -acc[0] / acc[1]
+                        s = ti.min(ti.max(1.0 - delta * self.coef.l0[None] * h, 0.5), 1.5)
+                self.tolman[i] = s
+
+        @ti.kernel
+        def _apply(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.colour[i] *= self.tolman[i]
+
+    return TolmanStress
+
+
+def tolman_fit_member(base, delta: float):
+    """``--tolman-pass DELTA --tolman-fit``: as tolman_member, H_i from the curvature member's
+    least-squares surface fit (curvature.py: frame, monomials, fit_curvature, the outer layer
+    only; s_i = 1 where i lies under the layer or the fit is singular)."""
+    from crowndemo.core.operators import weight
+    from crowndemo.core.state import FLUID, WALL
+    from crowndemo.core.surface_tension import curvature as cv
+
+    @ti.data_oriented
+    class TolmanFitStress(tolman_member(base, delta)):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            k = 3 if self.dim == 2 else 6
+            self.fit_sums = ti.types.struct(m=ti.types.matrix(k, k, float),
+                                            b=ti.types.vector(k, float), f=ti.types.matrix(
+                                                self.dim, self.dim, float), count=ti.i32,
+                                            out=ti.i32)
+
+        @ti.func
+        def _fit_pair(self, i, j, rij, r2, acc: ti.template()):
+            kind_j = self.state.kind[j]
+            if kind_j == FLUID or kind_j == WALL:
+                x = acc.f @ (rij / self.coef.l0[None])
+                h = x[self.dim - 1]
+                if h > cv.LAYER:
+                    acc.out += 1
+                elif h > -cv.LAYER and kind_j == FLUID:
+                    phi = cv.monomials(x)
+                    w = weight(ti.sqrt(r2), self.coef.re[None])
+                    acc.m += w * phi.outer_product(phi)
+                    acc.b += w * h * phi
+                    acc.count += 1
+
+        @ti.kernel
+        def _curvature(self):
+            k = ti.static(3 if self.dim == 2 else 6)
+            w_self = weight(self.coef.l0[None], self.coef.re[None])
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                s = 1.0
+                g = self.colour[i]
+                if self.state.kind[i] == FLUID and g.norm() > 0.0:
+                    acc = self.fit_sums(m=ti.Matrix.zero(float, k, k), b=ti.Vector.zero(float, k),
+                                        f=cv.frame(-g.normalized()), count=0, out=0)
+                    acc.m[0, 0] += w_self
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._fit_pair, acc)
+                    if acc.out == 0 and acc.count + 1 >= k:
+                        c, ok = cv.solve_spd(acc.m, acc.b)
+                        if ok == 1:
+                            cap = ti.static(float(self.dim - 1))
+                            kap = ti.min(ti.max(cv.fit_curvature(c), -cap), cap)
+                            s = ti.min(ti.max(1.0 - delta * kap / cap, 0.5), 1.5)
+                self.tolman[i] = s
+
+    return TolmanFitStress
+
+
 def zero_surface_member(base):
     """``base`` without the member's free-surface pressure (C4): P = 0 there, as S17/M3 leave
     it (the first member's; the --surface levers start from it)."""
@@ -750,6 +875,14 @@ def main() -> None:
                     help="the divergence's pair weight (default: the base's)")
     ap.add_argument("--membrane", action="store_true")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
+    ap.add_argument("--tolman", type=float, default=None,
+                    help="C5's delta (l0) for this run's dimension (default: the base's; "
+                         "--base first: 0)")
+    ap.add_argument("--tolman-pass", type=float, default=None, metavar="DELTA",
+                    help="the study's C5: a third pass, s_i of this step (tolman_member); "
+                         "C5 itself off")
+    ap.add_argument("--tolman-fit", action="store_true",
+                    help="--tolman-pass: H from the least-squares surface fit")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -800,6 +933,12 @@ def main() -> None:
             raise SystemExit("--own-per-area needs --tangential-moment")
         member = own_pressure_member(member, a.own_factor, a.own_per_area,
                                      spacing=a.surface == "own-spacing")
+    if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
+        stress.STRESS_TOLMAN[dim] = 0.0 if a.tolman is None else a.tolman   # read at __init__
+    if a.tolman_pass is not None:
+        if a.tolman is not None:
+            raise SystemExit("--tolman-pass: not with --tolman")
+        member = (tolman_fit_member if a.tolman_fit else tolman_member)(member, a.tolman_pass)
     family.MODELS["stress"] = member
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)

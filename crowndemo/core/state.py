@@ -47,6 +47,7 @@ class ParticleState:
         self.chunks_per_thread = ti.field(ti.i32, shape=())    # see spread
         self._persistent: Dict[str, ti.Field] = {}
         self._carried: Dict[str, ti.Field] = {}       # members' fields: see ``carry``
+        self._initial: Dict[str, float] = {}
         self.pos = self._register("pos", ti.Vector.field(dim, float, self.capacity))
         self.vel = self._register("vel", ti.Vector.field(dim, float, self.capacity))
         self.pressure = self._register("pressure", ti.field(float, self.capacity))
@@ -63,11 +64,14 @@ class ParticleState:
         self._persistent[name] = f
         return f
 
-    def carry(self, name: str, f: ti.Field) -> ti.Field:
+    def carry(self, name: str, f: ti.Field, initial: float = 0.0) -> ti.Field:
         """A model member's per-particle field that lasts from one step to the next (the
-        surface stress's lagged curvature factor): permuted with the persistent fields and
-        saved by ``dump``, not in snapshots; a checkpoint without it leaves it as it is."""
+        surface stress's lagged curvature factor): set to ``initial`` now and by ``load``,
+        permuted with the persistent fields and saved by ``dump``, not in snapshots; a
+        checkpoint without it (an older one) leaves it as it is."""
         self._carried[name] = f
+        self._initial[name] = initial
+        f.fill(initial)
         return f
 
     @property
@@ -98,6 +102,8 @@ class ParticleState:
         self.pressure.from_numpy(zero_f)
         self.density.from_numpy(zero_f)
         self.exit_reason.from_numpy(np.zeros(self.capacity, dtype=np.int32))
+        for name, f in self._carried.items():
+            f.fill(self._initial[name])
         self._set_count(n)
 
     def _set_count(self, n: int) -> None:

@@ -75,6 +75,9 @@ from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
 TOLMAN_CLAMP = (0.5, 1.5)    # s_i's range (C5): a lone or spray particle's H is no curvature
+# C5's normals: of particles with |g| l0 above this (a flat lattice face's outer layer: 0.50,
+# the next 3e-5); below it omega ~ 0 and g can be float rounding, its direction noise
+NORMAL_MIN = 0.1
 
 
 @ti.func
@@ -121,9 +124,10 @@ class StressTension:
         self.floor = None        # the analytic plane floor, where the model has one
         # C5: sigma (1 - delta H), delta in l0 (params.STRESS_TOLMAN); s_i lags one step
         self.delta = STRESS_TOLMAN[self.dim]
-        self.tolman = self.state.carry("stress_tolman", ti.field(float, cap))    # s_i
-        self.tolman_next = ti.field(float, cap)                                 # s_i, next
-        self.tolman.fill(1.0)
+        self.tolman = self.tolman_next = None
+        if self.delta > 0.0:
+            self.tolman = self.state.carry("stress_tolman", ti.field(float, cap), 1.0)   # s_i
+            self.tolman_next = ti.field(float, cap)                                  # next
         self.pass_sums = ti.types.struct(a=ti.types.vector(self.dim, float), h_num=float,
                                          h_den=float)    # pass 2's: a_i and C5's H_i
         self.symmetry = None     # the mirror planes, where the scene has them
@@ -133,8 +137,9 @@ class StressTension:
         self.floor, self.symmetry = floor, symmetry
 
     def nbytes(self) -> int:
-        return (field_nbytes(self.colour) + field_nbytes(self.accel)
-                + field_nbytes(self.tolman) + field_nbytes(self.tolman_next))
+        own = [self.colour, self.accel] + ([self.tolman, self.tolman_next] if self.delta > 0.0
+                                           else [])
+        return sum(field_nbytes(f) for f in own)
 
     def boundary_pressure(self) -> None:
         """The two passes (module docstring), then the free surface's pressure (C4)."""
@@ -177,7 +182,8 @@ class StressTension:
         n = self.state.n[None]
         for s in range(n, n + self.state.n_images[None]):
             self.colour[s] = self.symmetry._mirrored(self.colour[self.symmetry.source[s]], s)
-            self.tolman[s] = self.tolman[self.symmetry.source[s]]
+            if ti.static(self.delta > 0.0):
+                self.tolman[s] = self.tolman[self.symmetry.source[s]]
 
     @ti.func
     def _pair_weight(self, r):
@@ -196,7 +202,8 @@ class StressTension:
                 f += stress_times(gj, rij) * self._tension(j)
             acc.a += f * self._pair_weight(r)
             if ti.static(self.delta > 0.0):
-                if r < self.coef.re[None] and gj.norm() > 0.0 and gi.norm() > 0.0:
+                g_min = NORMAL_MIN / self.coef.l0[None]
+                if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
                     ni = gi.normalized()          # C5's sums: the divergence of n = g/|g|
                     rt = rij - rij.dot(ni) * ni
                     w = stress_kernel(r, self.coef.re[None])
