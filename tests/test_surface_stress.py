@@ -244,8 +244,12 @@ def test_info_names_the_model_and_its_constants(capsys):
     assert st["model"] == "stress"
     assert st["constants"]["a"] == pytest.approx(stress_normaliser(2, 1.0, 2.1), rel=1e-9)
     assert st["constants"]["K_1_m2"] == pytest.approx(lat.stress_K, rel=1e-9)
+    assert "delta_l0" not in st["constants"]          # C5 is 3D's
     assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress"]) == 0
     assert "tension     stress: the continuum surface stress" in capsys.readouterr().out
+    assert main(["info", "quick", "--set", "numerics.surface_tension=stress"]) == 0
+    from crowndemo.core.params import STRESS_TOLMAN
+    assert f"delta {STRESS_TOLMAN[3]:g} l0" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("dim", [2, 3])

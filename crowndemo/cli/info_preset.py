@@ -7,7 +7,7 @@ import shlex
 from typing import Dict
 
 from .. import strictjson
-from ..core.params import SOUND_SPEED_FACTOR
+from ..core.params import SOUND_SPEED_FACTOR, STRESS_TOLMAN
 from .common import load_preset
 
 
@@ -19,11 +19,14 @@ SURFACE_TENSION_WHAT = {
 
 
 def surface_tension_summary(model: str, lat, sigma: float) -> dict:
-    """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3)."""
+    """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3;
+    C5's delta in 3D)."""
     if model == "potential":
         constants = {"C": lat.C}
     elif model == "stress":
         constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd}
+        if STRESS_TOLMAN[lat.dim] > 0:      # C5's curvature correction (3D)
+            constants["delta_l0"] = STRESS_TOLMAN[lat.dim]
     else:
         constants = {}
     return {"model": model, "what": SURFACE_TENSION_WHAT[model], "sigma_N_m": sigma,
@@ -174,9 +177,10 @@ def info_preset(args) -> int:
           f"{f['lambda0_over_l0_sq']:.6g} l0^2), C {f['C']:.6g} {c_unit}, mass {f['mass']:.6g} "
           f"{f['mass_unit']}")
     st = f["surface_tension"]
-    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2"}
+    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "delta_l0": " l0"}
     print(f"  tension     {st['model']}: {st['what']}" + "".join(
-        f"; {k.split('_1_')[0]} {v:.6g}{units.get(k, '')}" for k, v in st["constants"].items()))
+        f"; {k.split('_1_')[0].removesuffix('_l0')} {v:.6g}{units.get(k, '')}"
+        for k, v in st["constants"].items()))
     print(f"  sound speed c = {f['sound_speed_m_s']:.4g} m/s ({f['sound_speed_source']})")
     n = f["numerics"]
     beta = n["beta"] if n["beta"] is not None else r.numerics.free_surface_beta(r.dim)
