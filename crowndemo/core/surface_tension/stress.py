@@ -7,7 +7,7 @@ tensor (Lafaurie et al., J. Comput. Phys. 113, 1994; in SPH Hu & Adams, J. Compu
 with g the gradient of the liquid's colour (1 in the liquid, 0 outside). T is a tension along
 the surface layer with no normal component: on a flat surface its divergence vanishes, on a
 curved one it sums to sigma kappa n over the layer, the Young-Laplace jump, with no curvature
-computed. Two neighbour passes at r*, after the number density (S17), the free surface's
+needed (in 3D, C5 below corrects the tension by one). Two neighbour passes at r*, after the number density (S17), the free surface's
 pressure and, in 3D, a curvature correction:
 
 1. the colour gradient (C1), g_i = omega_i K sum_j r_ij f(r_ij) over every neighbour kind,
