@@ -1,7 +1,7 @@
 """The surface stress's curvature correction (C5, core/surface_tension/stress.py, method.md
-§4c): the curvature it reads on a smooth ball and a flat face, Newton's third law with it, and its factor
-carried through a re-sort and a checkpoint (state.carry). What it does to a drop is
-tests/test_surface_stress.py's 3D quick rows (the resting drop's Laplace pressure, the
+§4c): the curvature it reads on a smooth ball and a flat face, Newton's third law with it,
+and its factor carried through a re-sort and a checkpoint (state.carry). What it does to a
+drop is tests/test_surface_stress.py's 3D quick rows (the resting drop's Laplace pressure, the
 oscillating drop's frequency).
 
 Expected values come from geometry: a sphere's mean curvature at radius r is 1/r, a

@@ -7,8 +7,8 @@ tensor (Lafaurie et al., J. Comput. Phys. 113, 1994; in SPH Hu & Adams, J. Compu
 with g the gradient of the liquid's colour (1 in the liquid, 0 outside). T is a tension along
 the surface layer with no normal component: on a flat surface its divergence vanishes, on a
 curved one it sums to sigma kappa n over the layer, the Young-Laplace jump, with no curvature
-needed (in 3D, C5 below corrects the tension by one). Two neighbour passes at r*, after the number density (S17), the free surface's
-pressure and, in 3D, a curvature correction:
+needed (in 3D, C5 below corrects the tension by one). Two neighbour passes at r*, after the
+number density (S17), the free surface's pressure and, in 3D, a curvature correction:
 
 1. the colour gradient (C1), g_i = omega_i K sum_j r_ij f(r_ij) over every neighbour kind,
    f(r) = (1 - r/re)^3 (a Wendland C2 kernel's gradient: bounded where the MPS w/r^2 is not;
@@ -22,11 +22,12 @@ pressure and, in 3D, a curvature correction:
    flat lattice surface carry exactly sigma (lattice.stress_normaliser);
 2. the divergence in the sum form (C3),
    a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij),  f_d(r) = (1 - (r/H)^4)^2, H = 3 l0,
-   T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d (each T times C5's s). Each pair's terms are equal
-   and opposite (for a fluid j), so the model conserves momentum exactly: a free drop cannot
-   drift by its own surface tension. f_d is zero with zero slope at H, beyond the lattice's
-   pairs at 2 l0, so the tension a surface carries hardly depends on how closely its outer
-   layer sits (within 5 % over 0.95-1.15 l0; the first member's 1 - (r/re)^4, support re,
+   T_j = 0 for wall and dummy particles, K_d = d / sum_j r^2 f_d (each T times C5's s). Each
+   pair's terms are equal and opposite (for a fluid j), so the model conserves momentum
+   exactly: a free drop cannot drift by its own surface tension. f_d is zero with zero slope
+   at H, beyond the lattice's pairs at 2 l0, so the tension a surface carries hardly depends
+   on how closely its outer layer sits (within 5 % over 0.95-1.15 l0; the first member's
+   1 - (r/re)^4, support re,
    had its edge at the lattice's 2 l0 pairs and carried 1.40 sigma when the layer packed to
    0.85 l0, 0.75 sigma stretched to 1.05 l0: VALIDATION.md, "The pair kernel's edge"). This
    pass walks to H beyond re (the grid's wide walk, grid.py). The pair force r f_d(r) grows
