@@ -662,12 +662,10 @@ def tolman_member(base, delta: float):
         @ti.func
         def _curvature_pair(self, i, j, rij, r2, acc: ti.template()):
             gj = self.colour[j]
-            if self.state.kind[j] != GONE and gj.norm() > 0.0:
-                ni = self.colour[i].normalized()
-                f = _stress.stress_kernel(ti.sqrt(r2), self.coef.re[None])
-                rt = rij - rij.dot(ni) * ni
-                acc[0] += (gj.normalized() - ni).dot(rij) * f
-                acc[1] += rt.dot(rt) * f
+            if self.state.kind[j] != GONE and gj.norm() > 0.0:    # C5's sums, no threshold
+                acc += _stress.normal_divergence_terms(
+                    self.colour[i].normalized(), gj.normalized(), rij,
+                    _stress.stress_kernel(ti.sqrt(r2), self.coef.re[None]))
 
         @ti.kernel
         def _curvature(self):
@@ -678,9 +676,7 @@ def tolman_member(base, delta: float):
                     acc = ti.Vector([0.0, 0.0])
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._curvature_pair, acc)
-                    if acc[1] > 0.0:
-                        h = -acc[0] / acc[1]
-                        s = ti.min(ti.max(1.0 - delta * self.coef.l0[None] * h, 0.5), 1.5)
+                    s = _stress.tolman_factor(acc, delta * self.coef.l0[None])
                 self.tolman[i] = s
 
         @ti.kernel

@@ -110,6 +110,25 @@ def stress_times(g, r):
     return out
 
 
+@ti.func
+def normal_divergence_terms(ni, nj, rij, w):
+    """A pair's share of C5's curvature sums: [(n_j - n_i) . r_ij w, |r_t|^2 w], r_t r_ij's part
+    in i's tangent plane (unit normals n_i, n_j); H_i = -(first sum)/(second sum)."""
+    rt = rij - rij.dot(ni) * ni
+    return ti.Vector([(nj - ni).dot(rij) * w, rt.dot(rt) * w])
+
+
+@ti.func
+def tolman_factor(sums, delta_l0):
+    """C5's s_i = clamp(1 - delta l0 H_i, TOLMAN_CLAMP) from the summed ``sums``
+    (normal_divergence_terms), H_i = -sums[0]/sums[1]; 1 where i has no such neighbours."""
+    s = 1.0
+    if sums[1] > 0.0:
+        lo, hi = ti.static(TOLMAN_CLAMP)
+        s = ti.min(ti.max(1.0 + delta_l0 * sums[0] / sums[1], lo), hi)
+    return s
+
+
 @ti.data_oriented
 class StressTension:
     name = "stress"
@@ -129,8 +148,8 @@ class StressTension:
         if self.delta > 0.0:
             self.tolman = self.state.carry("stress_tolman", ti.field(float, cap), 1.0)   # s_i
             self.tolman_next = ti.field(float, cap)                                  # next
-        self.pass_sums = ti.types.struct(a=ti.types.vector(self.dim, float), h_num=float,
-                                         h_den=float)    # pass 2's: a_i and C5's H_i
+        self.pass_sums = ti.types.struct(a=ti.types.vector(self.dim, float),
+                                         h=ti.types.vector(2, float))   # pass 2's: a_i, C5's H_i
         self.symmetry = None     # the mirror planes, where the scene has them
 
     def attach(self, floor, symmetry) -> None:
@@ -205,11 +224,8 @@ class StressTension:
             if ti.static(self.delta > 0.0):
                 g_min = NORMAL_MIN / self.coef.l0[None]
                 if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
-                    ni = gi.normalized()          # C5's sums: the divergence of n = g/|g|
-                    rt = rij - rij.dot(ni) * ni
-                    w = stress_kernel(r, self.coef.re[None])
-                    acc.h_num += (gj.normalized() - ni).dot(rij) * w
-                    acc.h_den += rt.dot(rt) * w
+                    acc.h += normal_divergence_terms(   # C5: the divergence of n = g/|g|
+                        gi.normalized(), gj.normalized(), rij, stress_kernel(r, self.coef.re[None]))
 
     @ti.func
     def _tension(self, i):
@@ -226,12 +242,12 @@ class StressTension:
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
         reach2 = (STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2      # H^2: the wide walk
-        lo, hi = ti.static(TOLMAN_CLAMP)
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             s_next = 1.0
             if self.state.kind[i] == FLUID:
-                acc = self.pass_sums(a=ti.Vector.zero(float, self.dim), h_num=0.0, h_den=0.0)
+                acc = self.pass_sums(a=ti.Vector.zero(float, self.dim),
+                                     h=ti.Vector.zero(float, 2))
                 self.grid.for_each_wide(i, self.state.pos[i], reach2, self._divergence_pair, acc)
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
@@ -239,9 +255,7 @@ class StressTension:
                     acc.a += stress_times(self.colour[i], ez) * self._tension(i)
                 self.accel[i] = scale * acc.a
                 if ti.static(self.delta > 0.0):
-                    if acc.h_den > 0.0:     # H_i = -sum (n_j - n_i).r_ij f / sum |r_t|^2 f (C5)
-                        h = -acc.h_num / acc.h_den
-                        s_next = ti.min(ti.max(1.0 - self.delta * self.coef.l0[None] * h, lo), hi)
+                    s_next = tolman_factor(acc.h, self.delta * self.coef.l0[None])      # C5
             if ti.static(self.delta > 0.0):
                 self.tolman_next[i] = s_next
 
