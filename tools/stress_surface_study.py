@@ -879,6 +879,9 @@ def main() -> None:
                          "C5 itself off")
     ap.add_argument("--tolman-fit", action="store_true",
                     help="--tolman-pass: H from the least-squares surface fit")
+    ap.add_argument("--nu", type=float, default=None,
+                    help="case stress-drop-oscillation-*: the drop's kinematic viscosity "
+                         "[m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -936,6 +939,11 @@ def main() -> None:
             raise SystemExit("--tolman-pass: not with --tolman")
         member = (tolman_fit_member if a.tolman_fit else tolman_member)(member, a.tolman_pass)
     family.MODELS["stress"] = member
+    if a.nu is not None:
+        if a.what != "case" or "oscillation" not in a.args[0]:
+            raise SystemExit("--nu: case stress-drop-oscillation-2d|3d only")
+        from crowndemo.validate import tension_cases
+        tension_cases.OSCILLATION_NU = a.nu
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
     else:
