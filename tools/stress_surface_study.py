@@ -9,6 +9,7 @@ layer does" and after, issue 23), reproducible:
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
+                          [--nu NU] [--sound-factor F]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
 
@@ -66,6 +67,9 @@ for the member before C5 (``--base first`` runs without C5 unless given); ``--to
 DELTA``: the study that led to C5 (C5 off): s_i from this step's normals in a third pass
 between pass 1 and pass 2 (tolman_member), with ``--tolman-fit`` H_i from the curvature
 member's surface fit instead of the normals' divergence (tolman_fit_member).
+``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``;
+tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound speed F times
+drop_sound_speed's (the compression under the cohesion 1 % / F^2).
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
 ``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
 same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
@@ -882,6 +886,8 @@ def main() -> None:
     ap.add_argument("--nu", type=float, default=None,
                     help="case stress-drop-oscillation-*: the drop's kinematic viscosity "
                          "[m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
+    ap.add_argument("--sound-factor", type=float, default=None,
+                    help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -944,6 +950,10 @@ def main() -> None:
             raise SystemExit("--nu: case stress-drop-oscillation-2d|3d only")
         from crowndemo.validate import tension_cases
         tension_cases.OSCILLATION_NU = a.nu
+    if a.sound_factor is not None:
+        from crowndemo.scenes import drop as drop_scene
+        sound_speed = drop_scene.drop_sound_speed
+        drop_scene.drop_sound_speed = lambda *args: a.sound_factor * sound_speed(*args)
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
     else:
