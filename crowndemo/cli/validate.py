@@ -12,6 +12,9 @@ from .common import (EXIT_FAILED, EXIT_INTERRUPTED, PROG, Fmt, UsageError, add_q
                      path_argument, repo_root, require_folder, start_backend)
 
 GROUPS = ("stability", "verdicts")
+# what --quick leaves out unless named: the costly crown case, the 3D free drop (10 periods,
+# ~100 s at its quick R/l0 = 8; the 2D one checks the same conservation) and the verdicts
+QUICK_LEAVES_OUT = ("crown-base-3m-drop", "stress-free-drop-3d", "verdicts")
 INTERRUPTED = "**Interrupted (Ctrl-C): a partial run; only the runs that finished are reported.**"
 
 VALIDATE_EPILOG = """\
@@ -25,16 +28,16 @@ examples:
   crowndemo validate --record                    # also rewrite VALIDATION.md
 
 Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer,
-stress-laplace, stress-drop-oscillation (each -2d and -3d), stress-free-drop,
+stress-laplace, stress-drop-oscillation, stress-free-drop (each -2d and -3d),
 crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. The stress- cases run the
-surface-stress model (method.md §4c) with the sum gradient form (stress-free-drop: -2d only),
-their drops started off the lattice (variant lattice: on it). Each case runs
+surface-stress model (method.md §4c) with the sum gradient form, their 3D drops started off
+the lattice (variant lattice: on it). Each case runs
 at three resolutions in the base settings and, at the middle one, in its settings variants
 (--list says which case runs which):
   {variants}
 --quick runs each case at one coarse resolution and in one of its variants (--list names
-it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop and the verdicts unless
-named; it compiles as with --fast-compile (unless $CROWNDEMO_FAST_COMPILE says otherwise).
+it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop, stress-free-drop-3d and
+the verdicts unless named; it compiles as with --fast-compile (unless $CROWNDEMO_FAST_COMPILE says otherwise).
 Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
 matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
 validation.json (strict JSON: null for a value that is not a finite number). A run that
@@ -105,7 +108,7 @@ def _names(args, table) -> list:
     """The cases and groups to run, each once, in the order given; UsageError for unknown."""
     names = list(dict.fromkeys(args.cases)) or (list(table) + list(GROUPS))
     if args.quick and not args.cases:
-        names = [n for n in names if n not in ("crown-base-3m-drop", "verdicts")]
+        names = [n for n in names if n not in QUICK_LEAVES_OUT]
     unknown = [n for n in names if n not in table and n not in GROUPS]
     if unknown:
         from ..config.errors import did_you_mean

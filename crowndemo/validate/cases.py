@@ -358,7 +358,7 @@ QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  # one other gradient form, on the free drop (each form compiles a model)
                  "stress-laplace-2d": None, "stress-laplace-3d": None,
                  "stress-drop-oscillation-2d": None, "stress-drop-oscillation-3d": None,
-                 "stress-free-drop-2d": "gradient=pmin"}
+                 "stress-free-drop-2d": "gradient=pmin", "stress-free-drop-3d": None}
 
 
 def all_cases(full: bool = True) -> Dict[str, Case]:
