@@ -108,7 +108,7 @@ def _preset_facts(r, tp) -> Dict:
 
 
 def _model_cost(r, cost: dict) -> str:
-    """', the stress model's passes included (2.75 x the potential's)' where the member
+    """', the stress model's passes included (3.11 x the potential's)' where the member
     costs other than the seed's potential (estimate.SURFACE_TENSION_COST), else ''."""
     if cost["surface_tension_model"] == 1.0:
         return ""

@@ -66,9 +66,11 @@ WALL_COST = 0.25             # a wall or dummy particle-step / a fluid one (meas
 # A crown step's cost with each surface-tension model / the seed's potential's: the booth
 # 3m-drop timed whole, one run after the other, nothing else running (BENCHMARKS.md "The
 # surface-tension models' cost", 2026-12-05): 0.1365 s a step with the potential (0.1353 with
-# the sum form: the form costs nothing), 0.3724 with the stress member and the sum form (its
-# two passes, the pair pass walking to 3 l0, method.md §4c), 0.1714 with the curvature model.
-SURFACE_TENSION_COST = {"potential": 1.0, "stress": 2.75, "curvature": 1.26}
+# the sum form: the form costs nothing), 0.1714 with the curvature model; with the stress
+# member and the sum form 0.3724 before its curvature correction C5 and 0.4212 with it (its
+# two passes, the pair pass walking to 3 l0 and summing C5's curvature, method.md §4c;
+# BENCHMARKS.md "The stress model's cost with C5", against 0.1353 the same hour).
+SURFACE_TENSION_COST = {"potential": 1.0, "stress": 3.11, "curvature": 1.26}
 # A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
 # (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
 # 2026-11-23, this CPU): 4.9 s in 2D, 51.5 s in 3D (13-19 s with --fast-compile, BENCHMARKS.md
