@@ -94,6 +94,20 @@ def test_validate_runs_a_case_named_twice_once(tmp_path, ran, fake_backend):
     assert ran["cases"] == [["laplace-2d", "hydrostatic-2d"]]
 
 
+def test_quick_leaves_out_the_costly_cases_unless_named():
+    """--quick with no names leaves out the 3m-drop crown, the 3D free drop (10 periods of a
+    3D drop) and the verdicts; named, they run."""
+    from crowndemo.cli.validate import QUICK_LEAVES_OUT, _names
+    table = cases.all_cases(full=True)
+    quick = _names(types.SimpleNamespace(cases=[], quick=True), table)
+    assert not set(QUICK_LEAVES_OUT) & set(quick)
+    assert "stress-free-drop-2d" in quick and "stability" in quick
+    assert set(_names(types.SimpleNamespace(cases=[], quick=False), table)) >= set(
+        QUICK_LEAVES_OUT)
+    named = _names(types.SimpleNamespace(cases=["stress-free-drop-3d"], quick=True), table)
+    assert named == ["stress-free-drop-3d"]
+
+
 def test_quick_compiles_fast_unless_the_environment_says(tmp_path, ran, monkeypatch):
     """--quick asks the backend for the fast compile, unless $CROWNDEMO_FAST_COMPILE is set
     (then the backend reads it); the report's header says which."""
