@@ -37,7 +37,8 @@ at three resolutions in the base settings and, at the middle one, in its setting
   {variants}
 --quick runs each case at one coarse resolution and in one of its variants (--list names
 it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop, stress-free-drop-3d and
-the verdicts unless named; it compiles as with --fast-compile (unless $CROWNDEMO_FAST_COMPILE says otherwise).
+the verdicts unless named; it compiles as with --fast-compile (unless $CROWNDEMO_FAST_COMPILE
+says otherwise).
 Output in --out (default reports/): validation.md, validation.csv, error_vs_time.png (with
 matplotlib: pip install '.[plot]'), stability.md, verdicts.md, and all of it as
 validation.json (strict JSON: null for a value that is not a finite number). A run that
