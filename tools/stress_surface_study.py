@@ -9,7 +9,7 @@ layer does" and after, issue 23), reproducible:
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
-                          [--nu NU] [--sound-factor F]
+                          [--nu NU] [--sound-factor F] [--relaxed-start P]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
 
@@ -69,7 +69,9 @@ between pass 1 and pass 2 (tolman_member), with ``--tolman-fit`` H_i from the cu
 member's surface fit instead of the normals' divergence (tolman_fit_member).
 ``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``;
 tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound speed F times
-drop_sound_speed's (the compression under the cohesion 1 % / F^2).
+drop_sound_speed's (the compression under the cohesion 1 % / F^2); ``--relaxed-start P``:
+the 3D oscillating drop starts from its disordered start relaxed at rest for P periods
+(relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
 ``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
 same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
@@ -840,13 +842,48 @@ def stretch(spacings: str, beta: float, kernel: str) -> None:
               f" (g c) {t[1]:.3f}, (g c^2) {t[2]:.3f}", flush=True)
 
 
-def case(name: str, scales: str) -> None:
+def relaxed_start(l0: float, periods: float) -> np.ndarray:
+    """``--relaxed-start P``: the 3D case's disordered drop (its start, tension_cases.DISORDER)
+    run at rest for P mode-2 periods with nu = 1e-4 (the resting drops' viscosity, which damps
+    the start's melt), its particles about their centre: a liquid start without a melt."""
     from crowndemo.core import Numerics
+    from crowndemo.scenes.drop import resting_drop
+    from crowndemo.validate import tension_cases as tc
+    from crowndemo.validate.cases import simulator
+    t0 = time.time()
+    rest = resting_drop(dim=3, radius=tc.R, l0=l0, nu=1.0e-4, t_end=periods * tc.mode2_period(3),
+                        numerics=tc.stress_numerics(Numerics()), disorder=tc.DISORDER[3])
+    sim = simulator(rest)
+    sim.run(rest.t_end)
+    snap = sim.snapshot()
+    pos = snap["pos"].astype(float)
+    keep = tc.drop_particles(pos, snap["kind"])
+    v = snap["vel"][keep].astype(float)
+    p = pos[keep] - pos[keep].mean(axis=0)
+    print(f"relaxed start: {periods:g} periods at rest, {keep.sum()} of {len(keep)} particles "
+          f"kept, rms speed {math.sqrt((v * v).sum(axis=1).mean()):.3g} m/s, r_max / R "
+          f"{np.linalg.norm(p, axis=1).max() / tc.R:.4f}; {time.time() - t0:.0f} s", flush=True)
+    return p
+
+
+def case(name: str, scales: str, relaxed: float = 0.0) -> None:
+    """One row per R/l0 of a stress-* case; ``relaxed`` > 0 (``--relaxed-start``, the 3D
+    oscillating drop only): the drop starts from relaxed_start's particles, fitted from t = 0
+    (no melt to skip)."""
+    from crowndemo.core import Numerics
+    from crowndemo.scenes import drop as drop_scene
     from crowndemo.validate.tension_cases import tension_cases
     chosen = {c.name: c for c in tension_cases()}[name]
+    disordered = drop_scene.disordered
     for s in scales.split(","):
         t0 = time.time()
-        out = chosen.run(1.0e-3 / float(s), chosen.base(Numerics()))
+        kwargs = {}
+        if relaxed > 0.0:
+            start = relaxed_start(1.0e-3 / float(s), relaxed)
+            drop_scene.disordered = lambda pts, l0, amount, seed=0: start
+            kwargs = {"disorder": 0.0}          # the case fits from t = 0
+        out = chosen.run(1.0e-3 / float(s), chosen.base(Numerics()), **kwargs)
+        drop_scene.disordered = disordered
         extra = ", ".join(f"{k} {v:.4g}" for k, v in out.extra.items())
         print(f"{name} R/l0 = {s}: {out.measured:.4g} against {out.reference:.4g}, error "
               f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
@@ -888,6 +925,9 @@ def main() -> None:
                          "[m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
+    ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
+                    help="case stress-drop-oscillation-3d: start from the disordered drop "
+                         "relaxed at rest for P periods (relaxed_start), fitted from t = 0")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -945,6 +985,8 @@ def main() -> None:
             raise SystemExit("--tolman-pass: not with --tolman")
         member = (tolman_fit_member if a.tolman_fit else tolman_member)(member, a.tolman_pass)
     family.MODELS["stress"] = member
+    if a.relaxed_start > 0.0 and (a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
+        raise SystemExit("--relaxed-start: case stress-drop-oscillation-3d only")
     if a.nu is not None:
         if a.what != "case" or "oscillation" not in a.args[0]:
             raise SystemExit("--nu: case stress-drop-oscillation-2d|3d only")
@@ -957,7 +999,7 @@ def main() -> None:
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
     else:
-        case(a.args[0], a.args[1])
+        case(a.args[0], a.args[1], a.relaxed_start)
 
 
 if __name__ == "__main__":
