@@ -12,6 +12,7 @@ layer does" and after, issue 23), reproducible:
                           [--nu NU] [--sound-factor F] [--relaxed-start P]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
+    .venv/bin/python tools/stress_surface_study.py energy R/l0 [--base member] [--relaxed-start P]
 
 ``--base first`` (the default): the first member, whose figures the study tables up to
 2026-12-05 give: f_d = 1 - (r/re)^4 and P = 0 on the free surface (``first_member``, through
@@ -31,7 +32,8 @@ A_d/A and V_d/V (VALIDATION.md, "What sets the inside pressure") and the ratio o
 virial to the tension's (1 at rest); ``--profile`` adds P n/n0 over P_in in shells. ``case``: one
 row of a stress-* validation case (validate/tension_cases.py). ``stretch``: the tension a flat
 2D surface carries by the member's formulas when its outer layer's spacing is S l0, alone and
-with the tangential moment (``flat_tension``; numpy, no Taichi).
+with the tangential moment (``flat_tension``; numpy, no Taichi). ``energy``: where the 3D
+oscillating drop's kinetic energy goes (the mode's flow, the rest; ``energy``'s docstring).
 
 Experiments, not member options (VALIDATION.md says what each did):
 ``--surface zero``: P = 0 on the free surface (S17/M3 alone); ``--surface neighbours``:
@@ -889,9 +891,78 @@ def case(name: str, scales: str, relaxed: float = 0.0) -> None:
               f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
 
 
+def energy(scale: float, relaxed: float, every: int = 5) -> None:
+    """``energy R/l0``: the 3D oscillating drop (the case's, nu = OSCILLATION_NU, 3 periods;
+    with ``--relaxed-start P`` from relaxed_start's particles, else from the case's disordered
+    start) and where its kinetic energy goes. Each frame (40 a period, every EVERY-th printed)
+    the drop's velocities about its mean are fitted by a linear field v = G d and split into
+    the mode's strain (G's symmetric traceless part: mode 2's flow is exactly this), the
+    breathing (its trace) and the rotation (its antisymmetric part); the rest is the
+    non-linear motion, of which the share a cubic polynomial field fits is smooth (higher
+    modes) and the remainder the particles' own (noise). Then the deformation's fit, as the
+    case's."""
+    from crowndemo.core import Numerics
+    from crowndemo.scenes import drop as drop_scene
+    from crowndemo.validate import oscillation
+    from crowndemo.validate import tension_cases as tc
+    from crowndemo.validate.cases import simulator
+    l0 = tc.R / scale
+    disorder = tc.DISORDER[3]
+    if relaxed > 0.0:
+        start = relaxed_start(l0, relaxed)
+        drop_scene.disordered = lambda pts, l0_, amount, seed=0: start
+        disorder = 0.0
+    scene = drop_scene.oscillating_drop(dim=3, radius=tc.R, l0=l0, nu=tc.OSCILLATION_NU,
+                                        periods=3.0, numerics=tc.stress_numerics(Numerics()),
+                                        disorder=disorder)
+    sim = simulator(scene)
+    period = 2 * math.pi / scene.info["omega_rad_s"]
+    x_pow = [(a,) for a in range(3)] + [(a, b) for a in range(3) for b in range(a, 3)] + [
+        (a, b, c) for a in range(3) for b in range(a, 3) for c in range(b, 3)]
+    rows = []
+
+    def watch(s, index: int) -> None:
+        snap = s.snapshot()
+        pos = snap["pos"].astype(float)
+        keep = tc.drop_particles(pos, snap["kind"])
+        d = pos[keep] - pos[keep].mean(axis=0)
+        v = snap["vel"][keep].astype(float)
+        v = v - v.mean(axis=0)
+        G = np.linalg.lstsq(d, v, rcond=None)[0].T           # v ~ G d
+        S = 0.5 * (G + G.T)
+        tr = np.trace(S) / 3.0
+        parts = [S - tr * np.eye(3), tr * np.eye(3), 0.5 * (G - G.T)]
+        ke = 0.5 * (v * v).sum()
+        shares = [0.5 * ((d @ M.T) ** 2).sum() / ke for M in parts]
+        rest = v - d @ G.T
+        x = d / tc.R
+        mons = np.stack([np.ones(len(x))] + [np.prod(x[:, list(m)], axis=1) for m in x_pow],
+                        axis=1)
+        smooth = mons @ np.linalg.lstsq(mons, rest, rcond=None)[0]
+        e_rest, e_smooth = 0.5 * (rest * rest).sum(), 0.5 * (smooth * smooth).sum()
+        rows.append((s.stats.time, oscillation.deformation(pos[keep])))
+        if index % every == 0:
+            print(f"t/T {s.stats.time / period:5.2f}  KE / start's {ke / start_ke[0]:.3f}: mode "
+                  f"{shares[0]:.3f}, breathing {shares[1]:.3f}, rotation {shares[2]:.4f}, "
+                  f"non-linear {e_rest / ke:.3f} (smooth {e_smooth / max(e_rest, 1e-30):.2f} "
+                  f"of it; its rms speed {math.sqrt(2 * e_rest / len(d)):.3g} m/s)", flush=True)
+
+    v0 = sim.snapshot()["vel"].astype(float)
+    start_ke = [0.5 * float(((v0 - v0.mean(axis=0)) ** 2).sum())]
+    print(f"3D oscillating drop, R/l0 = {scale:g}, the mode's largest speed "
+          f"{np.linalg.norm(v0, axis=1).max():.3g} m/s", flush=True)
+    sim.run(scene.t_end, frame_times=np.linspace(0, scene.t_end, 121), on_frame=watch)
+    t, s = np.array(rows).T
+    after = t >= (0.0 if relaxed > 0.0 else period) - 1e-12
+    omega, decay = oscillation.fit(t[after], s[after])
+    print(f"the deformation's fit (from t = {t[after][0] / period:g} T): omega / Rayleigh "
+          f"{omega / scene.info['omega_rad_s']:.4f}, decay {decay:.1f} 1/s (Lamb "
+          f"{scene.info['decay_1_s']:.0f})", flush=True)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("what", choices=("drop", "case", "stretch"))
+    ap.add_argument("what", choices=("drop", "case", "stretch", "energy"))
     ap.add_argument("args", nargs="+")
     ap.add_argument("--base", choices=("first", "member"), default="first",
                     help="first: the first member (1 - (r/re)^4, P = 0 on the surface); "
@@ -943,7 +1014,8 @@ def main() -> None:
     from crowndemo.core import Numerics
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
-    dim = int(a.args[0]) if a.what == "drop" else int(a.args[0].rsplit("-", 1)[1][0])
+    dim = (int(a.args[0]) if a.what == "drop" else 3 if a.what == "energy"
+           else int(a.args[0].rsplit("-", 1)[1][0]))
     member = first_member(dim) if a.base == "first" else stress.StressTension
     if a.base == "member" and a.surface not in (None, "cumulative"):
         member = zero_surface_member(member)
@@ -985,7 +1057,8 @@ def main() -> None:
             raise SystemExit("--tolman-pass: not with --tolman")
         member = (tolman_fit_member if a.tolman_fit else tolman_member)(member, a.tolman_pass)
     family.MODELS["stress"] = member
-    if a.relaxed_start > 0.0 and (a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
+    if a.relaxed_start > 0.0 and a.what != "energy" and (
+            a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
         raise SystemExit("--relaxed-start: case stress-drop-oscillation-3d only")
     if a.nu is not None:
         if a.what != "case" or "oscillation" not in a.args[0]:
@@ -998,6 +1071,8 @@ def main() -> None:
         drop_scene.drop_sound_speed = lambda *args: a.sound_factor * sound_speed(*args)
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
+    elif a.what == "energy":
+        energy(float(a.args[0]), a.relaxed_start)
     else:
         case(a.args[0], a.args[1], a.relaxed_start)
 
