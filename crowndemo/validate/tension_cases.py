@@ -47,7 +47,7 @@ def stress_numerics(numerics: Numerics) -> Numerics:
 
 # The oscillating drops' kinematic viscosity [m^2/s]: Lamb's decay (method.md §7) 50 1/s in
 # 3D, 40 1/s in 2D at R = 1 mm; read at each run, so a study can vary it (VALIDATION.md, "The
-# 3D oscillating drop's decay": tools/stress_surface_study.py case ... --nu)
+# curvature correction C5": tools/stress_surface_study.py case ... --nu)
 OSCILLATION_NU = 1.0e-5
 
 EJECTED_BEYOND = 1.5        # a particle farther than this x R from the drop's centre has left it
