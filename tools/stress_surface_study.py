@@ -81,6 +81,7 @@ lattice (pair_normalisers); the tangential moment follows quartic or smooth.
 The levers compose (e.g. --tangential-moment --surface own).
 Runs on one thread (``--threads``) so that it can run beside a long recording."""
 import argparse
+import contextlib
 import functools
 import math
 import time
@@ -868,24 +869,35 @@ def relaxed_start(l0: float, periods: float) -> np.ndarray:
     return p
 
 
+@contextlib.contextmanager
+def relaxed_drop(l0: float, periods: float):
+    """Within it the drop scenes start from relaxed_start's particles (scenes/drop.disordered
+    replaced, put back after): yields the disorder to give the scene, 0 (no melt to fit past)."""
+    from crowndemo.scenes import drop as drop_scene
+    start = relaxed_start(l0, periods)
+    disordered = drop_scene.disordered
+    drop_scene.disordered = lambda pts, l0_, amount, seed=0: start
+    try:
+        yield 0.0
+    finally:
+        drop_scene.disordered = disordered
+
+
 def case(name: str, scales: str, relaxed: float = 0.0) -> None:
     """One row per R/l0 of a stress-* case; ``relaxed`` > 0 (``--relaxed-start``, the 3D
     oscillating drop only): the drop starts from relaxed_start's particles, fitted from t = 0
     (no melt to skip)."""
     from crowndemo.core import Numerics
-    from crowndemo.scenes import drop as drop_scene
     from crowndemo.validate.tension_cases import tension_cases
     chosen = {c.name: c for c in tension_cases()}[name]
-    disordered = drop_scene.disordered
     for s in scales.split(","):
         t0 = time.time()
-        kwargs = {}
+        l0 = 1.0e-3 / float(s)
         if relaxed > 0.0:
-            start = relaxed_start(1.0e-3 / float(s), relaxed)
-            drop_scene.disordered = lambda pts, l0, amount, seed=0: start
-            kwargs = {"disorder": 0.0}          # the case fits from t = 0
-        out = chosen.run(1.0e-3 / float(s), chosen.base(Numerics()), **kwargs)
-        drop_scene.disordered = disordered
+            with relaxed_drop(l0, relaxed) as disorder:     # the case fits from t = 0
+                out = chosen.run(l0, chosen.base(Numerics()), disorder=disorder)
+        else:
+            out = chosen.run(l0, chosen.base(Numerics()))
         extra = ", ".join(f"{k} {v:.4g}" for k, v in out.extra.items())
         print(f"{name} R/l0 = {s}: {out.measured:.4g} against {out.reference:.4g}, error "
               f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
@@ -907,14 +919,11 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
     from crowndemo.validate import tension_cases as tc
     from crowndemo.validate.cases import simulator
     l0 = tc.R / scale
-    disorder = tc.DISORDER[3]
-    if relaxed > 0.0:
-        start = relaxed_start(l0, relaxed)
-        drop_scene.disordered = lambda pts, l0_, amount, seed=0: start
-        disorder = 0.0
-    scene = drop_scene.oscillating_drop(dim=3, radius=tc.R, l0=l0, nu=tc.OSCILLATION_NU,
-                                        periods=3.0, numerics=tc.stress_numerics(Numerics()),
-                                        disorder=disorder)
+    with (relaxed_drop(l0, relaxed) if relaxed > 0.0 else
+          contextlib.nullcontext(tc.DISORDER[3])) as disorder:
+        scene = drop_scene.oscillating_drop(dim=3, radius=tc.R, l0=l0, nu=tc.OSCILLATION_NU,
+                                            periods=3.0, numerics=tc.stress_numerics(Numerics()),
+                                            disorder=disorder)
     sim = simulator(scene)
     period = 2 * math.pi / scene.info["omega_rad_s"]
     x_pow = [(a,) for a in range(3)] + [(a, b) for a in range(3) for b in range(a, 3)] + [
@@ -925,6 +934,9 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
         snap = s.snapshot()
         pos = snap["pos"].astype(float)
         keep = tc.drop_particles(pos, snap["kind"])
+        rows.append((s.stats.time, oscillation.deformation(pos[keep])))
+        if index % every:
+            return                  # the fit needs every frame's deformation, the split not
         d = pos[keep] - pos[keep].mean(axis=0)
         v = snap["vel"][keep].astype(float)
         v = v - v.mean(axis=0)
@@ -940,12 +952,10 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
                         axis=1)
         smooth = mons @ np.linalg.lstsq(mons, rest, rcond=None)[0]
         e_rest, e_smooth = 0.5 * (rest * rest).sum(), 0.5 * (smooth * smooth).sum()
-        rows.append((s.stats.time, oscillation.deformation(pos[keep])))
-        if index % every == 0:
-            print(f"t/T {s.stats.time / period:5.2f}  KE / start's {ke / start_ke[0]:.3f}: mode "
-                  f"{shares[0]:.3f}, breathing {shares[1]:.3f}, rotation {shares[2]:.4f}, "
-                  f"non-linear {e_rest / ke:.3f} (smooth {e_smooth / max(e_rest, 1e-30):.2f} "
-                  f"of it; its rms speed {math.sqrt(2 * e_rest / len(d)):.3g} m/s)", flush=True)
+        print(f"t/T {s.stats.time / period:5.2f}  KE / start's {ke / start_ke[0]:.3f}: mode "
+              f"{shares[0]:.3f}, breathing {shares[1]:.3f}, rotation {shares[2]:.4f}, "
+              f"non-linear {e_rest / ke:.3f} (smooth {e_smooth / max(e_rest, 1e-30):.2f} "
+              f"of it; its rms speed {math.sqrt(2 * e_rest / len(d)):.3g} m/s)", flush=True)
 
     v0 = sim.snapshot()["vel"].astype(float)
     start_ke = [0.5 * float(((v0 - v0.mean(axis=0)) ** 2).sum())]
@@ -997,8 +1007,9 @@ def main() -> None:
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
-                    help="case stress-drop-oscillation-3d: start from the disordered drop "
-                         "relaxed at rest for P periods (relaxed_start), fitted from t = 0")
+                    help="case stress-drop-oscillation-3d and energy: start from the "
+                         "disordered drop relaxed at rest for P periods (relaxed_start), "
+                         "fitted from t = 0")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -1059,7 +1070,7 @@ def main() -> None:
     family.MODELS["stress"] = member
     if a.relaxed_start > 0.0 and a.what != "energy" and (
             a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
-        raise SystemExit("--relaxed-start: case stress-drop-oscillation-3d only")
+        raise SystemExit("--relaxed-start: case stress-drop-oscillation-3d or energy only")
     if a.nu is not None:
         if a.what != "case" or "oscillation" not in a.args[0]:
             raise SystemExit("--nu: case stress-drop-oscillation-2d|3d only")
