@@ -10,9 +10,11 @@ layer does" and after, issue 23), reproducible:
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--relaxed-start P]
+                          [--pressure-filter] [--numerics KEY=VALUE ...]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
     .venv/bin/python tools/stress_surface_study.py energy R/l0 [--base member] [--relaxed-start P]
+                          [--amplitude A] [the drop options]
 
 ``--base first`` (the default): the first member, whose figures the study tables up to
 2026-12-05 give: f_d = 1 - (r/re)^4 and P = 0 on the free surface (``first_member``, through
@@ -69,11 +71,15 @@ for the member before C5 (``--base first`` runs without C5 unless given); ``--to
 DELTA``: the study that led to C5 (C5 off): s_i from this step's normals in a third pass
 between pass 1 and pass 2 (tolman_member), with ``--tolman-fit`` H_i from the curvature
 member's surface fit instead of the normals' divergence (tolman_fit_member).
-``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``;
-tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound speed F times
-drop_sound_speed's (the compression under the cohesion 1 % / F^2); ``--relaxed-start P``:
-the 3D oscillating drop starts from its disordered start relaxed at rest for P periods
-(relaxed_start: a liquid without the melt), fitted from t = 0.
+``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``,
+``energy``; tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound
+speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
+``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
+rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
+``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
+Shepard mean over the pressurised fluid particles about them (neighbours_pressure_member, filtered), before
+the surface's own; ``--numerics KEY=VALUE``: the drops' params.Numerics with KEY set (e.g.
+collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1).
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
 ``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
 same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
@@ -93,9 +99,13 @@ from crowndemo import backend
 from crowndemo.core.surface_tension import stress as _stress
 
 
-def neighbours_pressure_member(base, scaled: bool = False):
+def neighbours_pressure_member(base, scaled: bool = False, filtered: bool = False):
     """``base`` with the ``--surface neighbours`` pass (module docstring); ``scaled``: the
-    ``--surface virial`` one (times n0/n_i)."""
+    ``--surface virial`` one (times n0/n_i). ``filtered`` (``--pressure-filter``) instead:
+    before the surface's own pressure, each fluid particle with P_i > 0 takes the Shepard mean
+    of the pressurised fluid particles about it, itself included, P_i <- sum_j P_j W_ij /
+    sum_j W_ij, W = (1 - r/re)^2 (W_ii = 1): the particle-scale pressure noise averaged over
+    the kernel."""
     from crowndemo.core.operators import weight
     from crowndemo.core.state import FLUID
 
@@ -113,16 +123,23 @@ def neighbours_pressure_member(base, scaled: bool = False):
         @ti.func
         def _pressurised(self, i, j, rij, r2, acc: ti.template()):
             if self.state.kind[j] == FLUID and self.state.pressure[j] > 0.0:
-                w = weight(ti.sqrt(r2), self.coef.re[None])
+                w = 0.0
+                if ti.static(filtered):
+                    w = (1.0 - ti.sqrt(r2) / self.coef.re[None]) ** 2
+                else:
+                    w = weight(ti.sqrt(r2), self.coef.re[None])
                 acc += ti.Vector([w * self.state.pressure[j], w])
 
         @ti.kernel
         def _neighbours_pressure(self):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
-                self.p_new[i] = self.state.pressure[i]
-                if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0:
-                    acc = ti.Vector([0.0, 0.0])
+                p_i = self.state.pressure[i]
+                self.p_new[i] = p_i
+                # filtered: the pressurised particles, themselves counted (W_ii = 1); else
+                # the free surface's (P = 0), from their neighbours alone
+                if self.state.kind[i] == FLUID and (p_i > 0.0) == ti.static(filtered):
+                    acc = ti.Vector([p_i, 1.0]) if ti.static(filtered) else ti.Vector([0.0, 0.0])
                     self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
                                                  self._pressurised, acc)
                     if acc[1] > 0.0:
@@ -903,7 +920,7 @@ def case(name: str, scales: str, relaxed: float = 0.0) -> None:
               f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
 
 
-def energy(scale: float, relaxed: float, every: int = 5) -> None:
+def energy(scale: float, relaxed: float, every: int = 5, amplitude: float = 0.1) -> None:
     """``energy R/l0``: the 3D oscillating drop (the case's, nu = OSCILLATION_NU, 3 periods;
     with ``--relaxed-start P`` from relaxed_start's particles, else from the case's disordered
     start) and where its kinetic energy goes. Each frame (40 a period, every EVERY-th printed)
@@ -911,8 +928,10 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
     the mode's strain (G's symmetric traceless part: mode 2's flow is exactly this), the
     breathing (its trace) and the rotation (its antisymmetric part); the rest is the
     non-linear motion, of which the share a cubic polynomial field fits is smooth (higher
-    modes) and the remainder the particles' own (noise). Then the deformation's fit, as the
-    case's."""
+    modes) and the remainder the particles' own (noise): its rms speed on the free surface
+    (n < beta n0) and by depth under it (the distance to the nearest free-surface particle),
+    and its correlation between neighbours closer than 1.3 l0. Then the deformation's fit, as
+    the case's. ``amplitude``: the mode's (``--amplitude``)."""
     from crowndemo.core import Numerics
     from crowndemo.scenes import drop as drop_scene
     from crowndemo.validate import oscillation
@@ -922,7 +941,8 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
     with (relaxed_drop(l0, relaxed) if relaxed > 0.0 else
           contextlib.nullcontext(tc.DISORDER[3])) as disorder:
         scene = drop_scene.oscillating_drop(dim=3, radius=tc.R, l0=l0, nu=tc.OSCILLATION_NU,
-                                            periods=3.0, numerics=tc.stress_numerics(Numerics()),
+                                            periods=3.0, amplitude=amplitude,
+                                            numerics=tc.stress_numerics(Numerics()),
                                             disorder=disorder)
     sim = simulator(scene)
     period = 2 * math.pi / scene.info["omega_rad_s"]
@@ -956,7 +976,29 @@ def energy(scale: float, relaxed: float, every: int = 5) -> None:
               f"{shares[0]:.3f}, breathing {shares[1]:.3f}, rotation {shares[2]:.4f}, "
               f"non-linear {e_rest / ke:.3f} (smooth {e_smooth / max(e_rest, 1e-30):.2f} "
               f"of it; its rms speed {math.sqrt(2 * e_rest / len(d)):.3g} m/s)", flush=True)
+        noise = rest - smooth
+        surface = snap["number_density"][keep] < beta_n0
+        if surface.any() and (~surface).any():     # each inner particle's depth under it
+            gap = d[~surface][:, None, :] - d[surface][None, :, :]
+            depth = np.zeros(len(d))
+            depth[~surface] = np.sqrt((gap * gap).sum(axis=2)).min(axis=1) / l0
+            bands = [("free surface (n < beta n0)", surface),
+                     ("depth < 2 l0", ~surface & (depth < 2.0)),
+                     ("2-3 l0", ~surface & (depth >= 2.0) & (depth < 3.0)),
+                     (">= 3 l0", ~surface & (depth >= 3.0))]
+            # the noise's correlation between neighbours (r < 1.3 l0): 1 smooth, 0 random,
+            # < 0 neighbours moving against each other
+            sep = d[:, None, :] - d[None, :, :]
+            near = np.triu((sep * sep).sum(axis=2) < (1.3 * l0) ** 2, k=1)
+            a, b = np.nonzero(near)
+            corr = (noise[a] * noise[b]).sum() / math.sqrt(
+                (noise[a] ** 2).sum() * (noise[b] ** 2).sum())
+            print("          particle-scale rms speed: " + ", ".join(
+                f"{name} ({m.sum()}) {math.sqrt((noise[m] ** 2).sum(axis=1).mean()):.3g}"
+                for name, m in bands if m.any()) + f" m/s; its correlation between "
+                f"neighbours {corr:.2f}", flush=True)
 
+    beta_n0 = sim.numerics.free_surface_beta(3) * sim.lattice.n0
     v0 = sim.snapshot()["vel"].astype(float)
     start_ke = [0.5 * float(((v0 - v0.mean(axis=0)) ** 2).sum())]
     print(f"3D oscillating drop, R/l0 = {scale:g}, the mode's largest speed "
@@ -1002,14 +1044,23 @@ def main() -> None:
     ap.add_argument("--tolman-fit", action="store_true",
                     help="--tolman-pass: H from the least-squares surface fit")
     ap.add_argument("--nu", type=float, default=None,
-                    help="case stress-drop-oscillation-*: the drop's kinematic viscosity "
-                         "[m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
+                    help="case stress-drop-oscillation-* and energy: the drop's kinematic "
+                         "viscosity [m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
                     help="case stress-drop-oscillation-3d and energy: start from the "
                          "disordered drop relaxed at rest for P periods (relaxed_start), "
                          "fitted from t = 0")
+    ap.add_argument("--numerics", action="append", default=[], metavar="KEY=VALUE",
+                    help="the drops' numerics with KEY (a params.Numerics field) set to VALUE "
+                         "(read as YAML), e.g. collision=0 (tension_cases.stress_numerics); "
+                         "repeatable")
+    ap.add_argument("--pressure-filter", action="store_true",
+                    help="the pressurised particles' pressure Shepard-filtered every step "
+                         "(neighbours_pressure_member, filtered)")
+    ap.add_argument("--amplitude", type=float, default=0.1,
+                    help="energy: the mode's relative amplitude (the case's 0.1)")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -1061,6 +1112,9 @@ def main() -> None:
             raise SystemExit("--own-per-area needs --tangential-moment")
         member = own_pressure_member(member, a.own_factor, a.own_per_area,
                                      spacing=a.surface == "own-spacing")
+    if a.pressure_filter:
+        member = neighbours_pressure_member(member, filtered=True)
+
     if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
         stress.STRESS_TOLMAN[dim] = 0.0 if a.tolman is None else a.tolman   # read at __init__
     if a.tolman_pass is not None:
@@ -1072,18 +1126,25 @@ def main() -> None:
             a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
         raise SystemExit("--relaxed-start: case stress-drop-oscillation-3d or energy only")
     if a.nu is not None:
-        if a.what != "case" or "oscillation" not in a.args[0]:
-            raise SystemExit("--nu: case stress-drop-oscillation-2d|3d only")
+        if a.what != "energy" and (a.what != "case" or "oscillation" not in a.args[0]):
+            raise SystemExit("--nu: case stress-drop-oscillation-2d|3d or energy only")
         from crowndemo.validate import tension_cases
         tension_cases.OSCILLATION_NU = a.nu
     if a.sound_factor is not None:
         from crowndemo.scenes import drop as drop_scene
         sound_speed = drop_scene.drop_sound_speed
         drop_scene.drop_sound_speed = lambda *args: a.sound_factor * sound_speed(*args)
+    if a.numerics:
+        import yaml
+        from crowndemo.core.params import with_values
+        from crowndemo.validate import tension_cases
+        changes = {k: yaml.safe_load(v) for k, v in (kv.split("=", 1) for kv in a.numerics)}
+        base_numerics = tension_cases.stress_numerics
+        tension_cases.stress_numerics = lambda n: with_values(base_numerics(n), **changes)
     if a.what == "drop":
         drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
     elif a.what == "energy":
-        energy(float(a.args[0]), a.relaxed_start)
+        energy(float(a.args[0]), a.relaxed_start, amplitude=a.amplitude)
     else:
         case(a.args[0], a.args[1], a.relaxed_start)
 
