@@ -920,6 +920,71 @@ def case(name: str, scales: str, relaxed: float = 0.0) -> None:
               f"{out.error:.2%}; {extra}; {time.time() - t0:.0f} s", flush=True)
 
 
+def dn_gradient(dim: int, re_over_l0: float = 2.1):
+    """``--gradient dn``: the pressure gradient's pair term (S11's r_ij w / r^2 in the sum
+    form) replaced by the number density's own derivative, -w'(r) r_ij / r = (w + 1) r_ij /
+    r^2 for w = re/r - 1, times n0 / (n0 + N0) (N0 the lattice's neighbours within re) so
+    that a lattice still reads a linear field's gradient (d/n0 sum (w + 1) r r / r^2 =
+    (n0 + N0)/n0 on it): with P_i + P_j the pair force of an EOS energy of the number
+    densities, as a Hamiltonian MPS has it (Suzuki et al. 2007); a study, patched into
+    core/pressure.py before its kernels compile."""
+    from crowndemo.core.lattice import n0_lambda0
+    d = np.arange(-3, 4)
+    grid = np.stack(np.meshgrid(*[d] * dim), axis=-1).reshape(-1, dim)
+    r = np.linalg.norm(grid, axis=1)
+    n0 = n0_lambda0(dim, 1.0, re_over_l0)[0]
+    scale = n0 / (n0 + int(((r > 0) & (r < re_over_l0)).sum()))
+
+    global GRADIENT_PROFILE
+    GRADIENT_PROFILE = scale          # term_powers' pressure force follows
+
+    @ti.func
+    def pair(dphi, rij, r2, w):
+        return dphi / r2 * (w + 1.0) * scale * rij
+    return pair
+
+
+GRADIENT_PROFILE = None     # dn_gradient's scale when the study replaced S11's pair term
+
+
+def term_powers(sim, snap, keep: np.ndarray, u: np.ndarray) -> dict:
+    """Each force's power on the drop particles' motion u (about their mean), per particle
+    [W]: m sum_i a_i . u_i over ``keep`` for the pressure gradient (the sum form, S11 with
+    P_i + P_j, from the snapshot's P), the viscous term (S12, nu times the Laplacian of u)
+    and the surface stress (the member's a_i of the last step); and each one's rms [m/s^2].
+    With ``--gradient dn`` the pressure's pair term is dn_gradient's.
+    numpy over every pair (a drop of a few thousand particles); the positions are the step's
+    end, P and the stress of its r*, so the split is a diagnostic, not the step's bookkeeping."""
+    from crowndemo.core.state import FLUID
+    lat, ph = sim.lattice, sim.physics
+    dim, re, n0, rho = ph.dim, lat.re, lat.n0, ph.rho
+    fluid = snap["kind"] == FLUID
+    x, v, p = (snap[k][fluid].astype(float) for k in ("pos", "vel", "pressure"))
+    rij = x[None, :, :] - x[:, None, :]                  # x_j - x_i
+    r = np.linalg.norm(rij, axis=2)
+    np.fill_diagonal(r, np.inf)
+    w = np.where(r < re, re / r - 1.0, 0.0)
+    profile = w if GRADIENT_PROFILE is None else np.where(r < re, (w + 1.0) * GRADIENT_PROFILE,
+                                                          0.0)       # dn_gradient's
+    acc = {"pressure": -dim / (n0 * rho) * np.einsum(
+               "ij,ijk->ik", (p[:, None] + p[None, :]) * profile / r ** 2, rij),
+           "viscosity": ph.nu * 2 * dim / (lat.lambda0 * n0) * (
+               np.einsum("ij,jk->ik", w, v) - w.sum(axis=1)[:, None] * v)}
+    n = sim.state.count
+    order = np.argsort(sim.state.pid.to_numpy()[:n], kind="stable")
+    acc["surface stress"] = sim.surface_tension.accel.to_numpy()[:n][order][fluid].astype(float)
+    inside = keep[fluid]
+    out = {}
+    for name, a in acc.items():
+        a = a[inside]
+        out[name] = (lat.mass * float((a * u).sum()) / len(u),
+                     math.sqrt(float((a * a).sum(axis=1).mean())))
+    total = sum(acc.values())[inside]
+    out["sum"] = (lat.mass * float((total * u).sum()) / len(u),
+                  math.sqrt(float((total * total).sum(axis=1).mean())))
+    return out
+
+
 def energy(scale: float, relaxed: float, every: int = 5, amplitude: float = 0.1) -> None:
     """``energy R/l0``: the 3D oscillating drop (the case's, nu = OSCILLATION_NU, 3 periods;
     with ``--relaxed-start P`` from relaxed_start's particles, else from the case's disordered
@@ -997,6 +1062,10 @@ def energy(scale: float, relaxed: float, every: int = 5, amplitude: float = 0.1)
                 f"{name} ({m.sum()}) {math.sqrt((noise[m] ** 2).sum(axis=1).mean()):.3g}"
                 for name, m in bands if m.any()) + f" m/s; its correlation between "
                 f"neighbours {corr:.2f}", flush=True)
+        powers = term_powers(s, snap, keep, v)
+        print("          power on the particles' motion per particle (W), rms acceleration "
+              "(m/s^2): " + ", ".join(f"{k} {pw:+.3g}, {ra:.3g}" for k, (pw, ra)
+                                      in powers.items()), flush=True)
 
     beta_n0 = sim.numerics.free_surface_beta(3) * sim.lattice.n0
     v0 = sim.snapshot()["vel"].astype(float)
@@ -1056,6 +1125,9 @@ def main() -> None:
                     help="the drops' numerics with KEY (a params.Numerics field) set to VALUE "
                          "(read as YAML), e.g. collision=0 (tension_cases.stress_numerics); "
                          "repeatable")
+    ap.add_argument("--gradient", choices=("mps", "dn"), default="mps",
+                    help="the pressure gradient's pair term: S11's (mps) or the number "
+                         "density's derivative (dn_gradient)")
     ap.add_argument("--pressure-filter", action="store_true",
                     help="the pressurised particles' pressure Shepard-filtered every step "
                          "(neighbours_pressure_member, filtered)")
@@ -1114,6 +1186,9 @@ def main() -> None:
                                      spacing=a.surface == "own-spacing")
     if a.pressure_filter:
         member = neighbours_pressure_member(member, filtered=True)
+    if a.gradient == "dn":
+        from crowndemo.core import pressure
+        pressure.gradient_pair = dn_gradient(dim)
 
     if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
         stress.STRESS_TOLMAN[dim] = 0.0 if a.tolman is None else a.tolman   # read at __init__
