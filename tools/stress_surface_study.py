@@ -10,7 +10,7 @@ layer does" and after, issue 23), reproducible:
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--relaxed-start P]
-                          [--pressure-filter] [--numerics KEY=VALUE ...]
+                          [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
     .venv/bin/python tools/stress_surface_study.py energy R/l0 [--base member] [--relaxed-start P]
@@ -79,7 +79,9 @@ rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
 Shepard mean over the pressurised fluid particles about them (neighbours_pressure_member, filtered), before
 the surface's own; ``--numerics KEY=VALUE``: the drops' params.Numerics with KEY set (e.g.
-collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1).
+collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1);
+``--gradient dn``: the pressure gradient's pair term the number density's derivative
+(dn_gradient) instead of S11's.
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
 ``smooth`` (1 - (r/re)^4)^2 (zero slope at re), ``smooth2`` / ``smooth25`` / ``smooth3`` the
 same with support 2 / 2.5 / 3 l0 (smooth3 is the member's), each with its K_d and a from the
