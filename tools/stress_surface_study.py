@@ -77,9 +77,9 @@ speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
-Shepard mean over the pressurised fluid particles about them (neighbours_pressure_member, filtered), before
-the surface's own; ``--numerics KEY=VALUE``: the drops' params.Numerics with KEY set (e.g.
-collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1);
+Shepard mean over the pressurised fluid particles about them (neighbours_pressure_member,
+filtered), before the surface's own; ``--numerics KEY=VALUE``: the drops' params.Numerics
+with KEY set (e.g. collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1);
 ``--gradient dn``: the pressure gradient's pair term the number density's derivative
 (dn_gradient) instead of S11's.
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
@@ -1186,6 +1186,9 @@ def main() -> None:
             raise SystemExit("--own-per-area needs --tangential-moment")
         member = own_pressure_member(member, a.own_factor, a.own_per_area,
                                      spacing=a.surface == "own-spacing")
+    if not (math.isfinite(a.amplitude) and a.amplitude > 0.0):
+        raise SystemExit(f"--amplitude {a.amplitude}: allowed: > 0 (the start's kinetic energy "
+                         "is the split's unit)")
     if a.pressure_filter:
         member = neighbours_pressure_member(member, filtered=True)
     if a.gradient == "dn":
