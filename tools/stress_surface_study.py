@@ -930,12 +930,9 @@ def dn_gradient(dim: int, re_over_l0: float = 2.1):
     (n0 + N0)/n0 on it): with P_i + P_j the pair force of an EOS energy of the number
     densities, as a Hamiltonian MPS has it (Suzuki et al. 2007); a study, patched into
     core/pressure.py before its kernels compile."""
-    from crowndemo.core.lattice import n0_lambda0
-    d = np.arange(-3, 4)
-    grid = np.stack(np.meshgrid(*[d] * dim), axis=-1).reshape(-1, dim)
-    r = np.linalg.norm(grid, axis=1)
+    from crowndemo.core.lattice import lattice_offsets, n0_lambda0
     n0 = n0_lambda0(dim, 1.0, re_over_l0)[0]
-    scale = n0 / (n0 + int(((r > 0) & (r < re_over_l0)).sum()))
+    scale = n0 / (n0 + len(lattice_offsets(dim, 1.0, re_over_l0)))
 
     global GRADIENT_PROFILE
     GRADIENT_PROFILE = scale          # term_powers' pressure force follows
@@ -957,6 +954,7 @@ def term_powers(sim, snap, keep: np.ndarray, u: np.ndarray) -> dict:
     With ``--gradient dn`` the pressure's pair term is dn_gradient's.
     numpy over every pair (a drop of a few thousand particles); the positions are the step's
     end, P and the stress of its r*, so the split is a diagnostic, not the step's bookkeeping."""
+    from crowndemo.core.lattice import weight
     from crowndemo.core.state import FLUID
     lat, ph = sim.lattice, sim.physics
     dim, re, n0, rho = ph.dim, lat.re, lat.n0, ph.rho
@@ -965,7 +963,7 @@ def term_powers(sim, snap, keep: np.ndarray, u: np.ndarray) -> dict:
     rij = x[None, :, :] - x[:, None, :]                  # x_j - x_i
     r = np.linalg.norm(rij, axis=2)
     np.fill_diagonal(r, np.inf)
-    w = np.where(r < re, re / r - 1.0, 0.0)
+    w = weight(r, re)                                   # S10 (0 on the diagonal, r = inf)
     profile = w if GRADIENT_PROFILE is None else np.where(r < re, (w + 1.0) * GRADIENT_PROFILE,
                                                           0.0)       # dn_gradient's
     acc = {"pressure": -dim / (n0 * rho) * np.einsum(
