@@ -114,3 +114,36 @@ def test_sliding_layer_follows_stokes_with_the_no_slip_plane_at_the_wall_layer(w
                                info["depth_m"], l0)
     offset = math.sqrt(math.pi) * l0 / (2 * delta)
     assert abs(deficit / info["deficit_m2_s"] - (1 - offset)) < 0.01
+
+
+def test_sliding_layer_with_the_central_viscosity_on_both_floors():
+    """The central form (method.md V1) on the same layer: on the lattice a shear along the
+    axes feels nu m22 / m22_iso (tests/test_viscosity.py: the cubic lattice's fourth moment;
+    0.855 in 2D), so the layer follows Stokes with that viscosity, delta' = delta sqrt(0.855):
+    its momentum deficit, over the no-slip plane's U delta / sqrt(pi), is sqrt(0.855) minus
+    the half spacing's sqrt(pi) l0 / (2 delta) (the test above), within 0.01. The plane floor's
+    V1 term (its vn_floor table, viscosity.CentralViscosity.floor) gives the particle floor's
+    deficit within 1e-3 of it."""
+    l0, delta = 1.0e-4, 1.0e-3
+    m4 = m22 = 0.0
+    for q in itertools.product(range(-3, 4), repeat=2):
+        r = math.hypot(*q)
+        if 0.0 < r < RE_RATIO:
+            w = RE_RATIO / r - 1.0
+            m4 += w * q[0] ** 4 / r ** 2
+            m22 += w * q[0] ** 2 * q[1] ** 2 / r ** 2
+    ratio = m22 / ((m4 + m22) * 2 / (2 * 4))          # m22 / m22_iso, lambda0 n0 = 2 (m4 + m22)
+    assert 0.8 < ratio < 0.9
+    deficits = {}
+    for wall_model in ("particles", "plane"):
+        numerics = with_values(Numerics(), wall_model=wall_model, viscosity="central")
+        scene = sliding_layer(dim=2, delta=delta, l0=l0, numerics=numerics)
+        sim = simulator_for(scene)
+        sim.run(scene.t_end)
+        snap, info = sim.snapshot(), scene.info
+        deficits[wall_model] = momentum_deficit(
+            snap["pos"], snap["vel"], snap["kind"], info["speed_m_s"], info["length_m"],
+            info["depth_m"], l0) / info["deficit_m2_s"]
+    offset = math.sqrt(math.pi) * l0 / (2 * delta)
+    assert abs(deficits["particles"] - (math.sqrt(ratio) - offset)) < 0.01
+    assert abs(deficits["plane"] - deficits["particles"]) < 1e-3

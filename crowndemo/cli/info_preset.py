@@ -7,7 +7,7 @@ import shlex
 from typing import Dict
 
 from .. import strictjson
-from ..core.params import SOUND_SPEED_FACTOR, STRESS_TOLMAN
+from ..core.params import SOUND_SPEED_FACTOR, STRESS_TOLMAN, VISCOUS_STIFFNESS
 from .common import load_preset
 
 
@@ -185,7 +185,8 @@ def info_preset(args) -> int:
     n = f["numerics"]
     beta = n["beta"] if n["beta"] is not None else r.numerics.free_surface_beta(r.dim)
     relative = n["courant_speed"] == "relative"
-    print(f"  numerics    gradient {n['pressure_gradient']}; safety courant {n['courant']:g}"
+    print(f"  numerics    gradient {n['pressure_gradient']}; viscosity {n['viscosity']}; "
+          f"safety courant {n['courant']:g}"
           + (f" on relative speeds, approach {n['approach']:g}" if relative else "") + ", "
           f"acoustic {n['acoustic']:g}, viscous {n['viscous']:g}, capillary {n['capillary']:g}; "
           f"beta {beta:g}")
@@ -198,7 +199,9 @@ def info_preset(args) -> int:
           f"{n['fixed_dt'] if n['fixed_dt'] is not None else 'none (adaptive)'}")
     rules = {"courant": f"{n['courant']:g} l0 / U" + (" (relative speed)" if relative else ""),
              "approach": f"{n['approach']:g} l0 / U", "acoustic": f"{n['acoustic']:g} l0 / c",
-             "viscous": f"{n['viscous']:g} l0^2 / nu",
+             "viscous": f"{n['viscous']:g} l0^2 / nu" + (
+                 f" / {VISCOUS_STIFFNESS[n['viscosity']]:g} ({n['viscosity']})"
+                 if VISCOUS_STIFFNESS[n['viscosity']] != 1.0 else ""),
              "capillary": f"{n['capillary']:g} sqrt(rho l0^3 / (2 pi sigma))",
              "dt_max": "numerics.dt_max"}
     print("  time step   limits at v = U; dt = the smallest:")

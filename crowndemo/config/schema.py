@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from typing import Any, Dict, Iterable, Optional, Tuple
 
 from ..core.params import (COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, SURFACE_TENSION_MODELS,
-                           WALL_MODELS, WATER)
+                           VISCOSITY_MODELS, WALL_MODELS, WATER)
 from ..core.symmetry import SYMMETRIES
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
@@ -162,6 +162,9 @@ NUMERICS_KEYS = {
                              "stress (stress, method.md §4c; with pressure_gradient: sum), or "
                              "P = sigma kappa on the free surface (curvature; experimental, "
                              "docs/surface_tension_curvature.md)", choices=SURFACE_TENSION_MODELS),
+    "viscosity": Field("choice", "viscosity model (core/viscosity.py): the seed's Laplacian "
+                       "(S12), or the central pair form (method.md V1), which dissipates as "
+                       "the Navier-Stokes equations at a free surface", choices=VISCOSITY_MODELS),
     "beta": number("free-surface threshold n < beta n0 (M3); with P clamped at 0 (n < n0 has "
                    "P = 0 anyway) it changes no pressure", "", 0.5, 1.0, lo_incl=True,
                    hi_incl=False),

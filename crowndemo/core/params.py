@@ -16,6 +16,14 @@ COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5;
 # continuum surface stress (method.md §4c) or the curvature-based pressure boundary condition
 # P = sigma kappa (Tsujimura et al. 2023; experimental)
 SURFACE_TENSION_MODELS = ("potential", "stress", "curvature")
+# the viscosity family (core/viscosity.py): the seed's Laplacian (S12) or the central pair form
+# (method.md V1), whose dissipation at a free surface is the Navier-Stokes equations'
+VISCOSITY_MODELS = ("laplacian", "central")
+# each member's stiffness: the viscous limit nu dt / l0^2 <= C_nu / stiffness (timestep.py).
+# The central form is nu (lap u + 2 grad div u): 3 nu k^2 on a sound wave against lap u's
+# nu k^2; on the lattice the largest eigenvalue of its pair sum is 2.80 (3D) / 2.87 (2D)
+# times the Laplacian's (tests/test_viscosity.py)
+VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 # the surface stress's divergence pair kernel reaches STRESS_PAIR_SUPPORT l0 (method.md C3):
 # beyond re = 2.1 l0, so its walk is the grid's wide one (grid.py)
 STRESS_PAIR_SUPPORT = 3.0
@@ -92,6 +100,7 @@ class Numerics:
     allow_unsafe_dt: bool = False   # only for tests that force an unstable run
     pressure_gradient: str = "pmin"
     surface_tension: str = "potential"   # SURFACE_TENSION_MODELS; compiled in when sigma > 0
+    viscosity: str = "laplacian"    # VISCOSITY_MODELS; compiled in when nu > 0
     beta: Optional[float] = None    # free-surface threshold n < beta n0 (M3); None: 0.97/0.98
     max_density_excess: float = 0.5  # abort when n/n0 - 1 exceeds this
     max_mach: float = 1.0           # abort when a speed exceeds max_mach * c
@@ -134,6 +143,7 @@ class Numerics:
              " | ".join(GRADIENT_FORMS))
         need(self.surface_tension in SURFACE_TENSION_MODELS, "surface_tension",
              " | ".join(SURFACE_TENSION_MODELS))
+        need(self.viscosity in VISCOSITY_MODELS, "viscosity", " | ".join(VISCOSITY_MODELS))
         need(self.beta is None or 0.5 <= self.beta < 1.0, "beta", "0.5 <= beta < 1")
         need(self.max_density_excess > 0, "max_density_excess", "> 0")
         need(self.max_mach > 0, "max_mach", "> 0")
@@ -175,6 +185,7 @@ class Model:
     predictor_list: bool = False     # the predictor's pairs from the last list (terms.py)
     surface_tension_model: str = "potential"   # the family member (core/surface_tension/)
     wide_walk: float = 1.0           # the grid's wide walk over re (grid.py; stress C3)
+    viscosity_model: str = "laplacian"   # the family member (core/viscosity.py)
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
@@ -185,7 +196,8 @@ class Model:
                    numerics.predictor_list and numerics.neighbour_list,
                    numerics.surface_tension,
                    max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio)
-                   if physics.sigma > 0 and numerics.surface_tension == "stress" else 1.0)
+                   if physics.sigma > 0 and numerics.surface_tension == "stress" else 1.0,
+                   numerics.viscosity)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
@@ -195,7 +207,8 @@ class Model:
                 "relative_courant": self.relative_courant,
                 "mirror_planes": list(self.mirror_planes),
                 "predictor_list": self.predictor_list,
-                "surface_tension_model": self.surface_tension_model}
+                "surface_tension_model": self.surface_tension_model,
+                "viscosity_model": self.viscosity_model}
 
 
 def _finite(x) -> bool:
@@ -215,4 +228,5 @@ def with_values(obj: _Params, **changes: Any) -> _Params:
 
 
 __all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "WALL_MODELS",
-           "COURANT_SPEEDS", "SURFACE_TENSION_MODELS", "with_values"]
+           "COURANT_SPEEDS", "SURFACE_TENSION_MODELS", "VISCOSITY_MODELS", "VISCOUS_STIFFNESS",
+           "with_values"]

@@ -8,7 +8,7 @@ lattice continued below the surface, wall particles at s = -l0/2 and ``layers - 
 layers under them. The tables are summed for a particle right above a column of that lattice,
 so a fluid lattice at rest sees exactly the number density it would see with the particles;
 a particle between columns sees the same values (the particle floor's lateral ripple is left
-out). Per height s, five sums over the layers' points j within re (within H = 3 l0 for d_floor,
+out). Per height s, six sums over the layers' points j within re (within H = 3 l0 for d_floor,
 the divergence's pair support):
 
 - n_floor(s) = sum over every layer of w(r)                 -> number density (S9)
@@ -17,6 +17,8 @@ the divergence's pair support):
   (P_i without gravity): with P_j = P_i the floor pushed too little and the 2D tank's floor
   pressure read 6.6 % low
 - v_floor(s) = sum over the wall layer of w(r)              -> viscosity (S12), u_j = 0
+- vn_floor(s) = sum over the wall layer of w (z_j - z_i)^2 / r^2 -> the central viscosity's
+  normal part (V1, core/viscosity.py), u_j = 0
 - c_floor(s) = sum over every layer of (z_j - z_i) f(r)     -> the surface-stress model's
   colour gradient (method.md C1): the floor is no free surface
 - d_floor(s) = sum over every layer of (z_j - z_i) f_d(r)   -> its divergence (C3), T_j = 0
@@ -35,13 +37,14 @@ import taichi as ti
 from .lattice import stress_kernel, stress_pair_kernel, stress_pair_support, weight
 
 SAMPLES = 1024
-FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C, FLOOR_D = 0, 1, 2, 3, 4
+FLOOR_N, FLOOR_G, FLOOR_V, FLOOR_C, FLOOR_D, FLOOR_VN = 0, 1, 2, 3, 4, 5
+FLOOR_SUMS = 6
 
 
 def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAMPLES,
                  reach: Optional[float] = None) -> Tuple[float, float, np.ndarray]:
-    """(s0, ds, table[samples, 5]): n_floor, g_floor (the component along the last axis),
-    v_floor, c_floor and d_floor (along the last axis) at s = s0 + k ds, from s0 = -l0/4 (closer, the
+    """(s0, ds, table[samples, FLOOR_SUMS]): n_floor, g_floor (the component along the last
+    axis), v_floor, c_floor, d_floor (along the last axis) and vn_floor at s = s0 + k ds, from s0 = -l0/4 (closer, the
     collision model has acted; the table holds its last value) to reach - l0/2 (beyond, no
     floor point is within reach). ``reach``: the widest walk, re (the default) or, for the
     surface stress, its pair support H (Model.wide_walk): d_floor is summed within H but
@@ -54,7 +57,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAM
     lateral = np.array(np.meshgrid(*[np.arange(-m, m + 1)] * (dim - 1), indexing="ij"))
     lateral = lateral.reshape(dim - 1, -1).T * l0                  # points of one layer
     lat2 = (lateral ** 2).sum(axis=1)
-    table = np.zeros((samples, 5))
+    table = np.zeros((samples, FLOOR_SUMS))
     for k in range(samples):
         s = s0 + k * ds
         for layer in range(layers):
@@ -67,13 +70,14 @@ def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAM
             if layer == 0:
                 table[k, FLOOR_G] += (dz / (r * r) * w).sum()
                 table[k, FLOOR_V] += w.sum()
+                table[k, FLOOR_VN] += (w * dz * dz / (r * r)).sum()
     return s0, ds, table
 
 
 @ti.data_oriented
 class PlaneFloor:
     def __init__(self):
-        self.table = ti.Vector.field(5, float, SAMPLES)
+        self.table = ti.Vector.field(FLOOR_SUMS, float, SAMPLES)
         self.s0 = ti.field(float, shape=())
         self.inv_ds = ti.field(float, shape=())
         self.wall_depth = ti.field(float, shape=())    # the wall layer's plane: s = -l0/2
@@ -94,7 +98,7 @@ class PlaneFloor:
 
     @ti.func
     def at(self, s):
-        """(n_floor, g_floor, v_floor, c_floor, d_floor) at height s, linear between samples;
+        """(n_floor, g_floor, v_floor, c_floor, d_floor, vn_floor) at height s, linear between samples;
         zero past the top."""
         # clamped before the cast: a height far up (or inf, NaN) would cast to INT_MIN
         x = ti.min((ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None],
@@ -116,4 +120,4 @@ class PlaneFloor:
 
 
 __all__ = ["PlaneFloor", "floor_tables", "FLOOR_N", "FLOOR_G", "FLOOR_V", "FLOOR_C",
-           "FLOOR_D"]
+           "FLOOR_D", "FLOOR_VN", "FLOOR_SUMS"]

@@ -50,10 +50,11 @@ from .coefficients import Coefficients
 from .grid import CellGrid
 from .neighbours import NeighbourList
 from .health import fluid_max
-from .operators import laplacian_pair, weight
+from .operators import weight
 from .params import Model
-from .plane_floor import FLOOR_V, PlaneFloor
+from .plane_floor import FLOOR_V, FLOOR_VN, PlaneFloor
 from .state import DUMMY, FLUID, GONE
+from .viscosity import member as viscosity_member
 
 CLOSE_SLOTS = 4     # pairs closer than the collision distance listed per particle (rare: the
 #                     lattice has none; a splash a few)
@@ -68,6 +69,8 @@ class Predictor:
         # the surface-tension member (core/surface_tension/); its pair term is summed in the
         # walk only when it has one (the curvature model acts through the pressure)
         self.surface = surface
+        # the viscosity member (core/viscosity.py): its pair term, factor and floor term
+        self.viscous = viscosity_member(model.viscosity_model)
         self.st_pairs = bool(model.surface_tension and surface is not None and surface.pair_term)
         # the density pass's list, for the pairs of ``forces(from_list=1)`` (module docstring)
         self.neighbours = neighbours if model.predictor_list and self._walks else None
@@ -140,9 +143,9 @@ class Predictor:
 
     @ti.func
     def _pair(self, i, j, rij, r2, acc: ti.template()):
-        """Sums, without their constant factors: sum (u_j - u_i) w (S12; walls have u = 0,
-        no-slip) and the surface-tension member's pair term over fluid j (the potential's
-        (r - l0)(r - re) r_ij / r, S24)."""
+        """Sums, without their constant factors: the viscosity member's pair term (S12's
+        (u_j - u_i) w, or V1's; walls have u = 0, no-slip) and the surface-tension member's
+        pair term over fluid j (the potential's (r - l0)(r - re) r_ij / r, S24)."""
         if ti.static(self.lists_close_pairs):
             if r2 < self.coef.col_r2[None]:      # every kind, as the collision walk
                 if acc.close < CLOSE_SLOTS:
@@ -155,7 +158,7 @@ class Predictor:
             if ti.static(self.measures_relative_speed):
                 acc.rel2 = ti.max(acc.rel2, du.dot(du))
             if ti.static(self.model.viscosity):
-                acc.visc += laplacian_pair(du, weight(r, self.coef.re[None]))
+                acc.visc += self.viscous.pair(du, rij, r2, weight(r, self.coef.re[None]))
             if ti.static(self.st_pairs):
                 if kind_j == FLUID:      # fluid-fluid (the potential's sign per method.md §4)
                     acc.st += self.surface.pair(rij, r)
@@ -205,13 +208,13 @@ class Predictor:
 
     @ti.kernel
     def _forces(self, from_list: ti.i32):
-        """a* = nu <lap u> + g + (C/m) sum of minus the potential's gradient (S14, S22) at
+        """a* = nu <lap u> (the viscosity member's, S12 or V1) + g + (C/m) sum of minus the potential's gradient (S14, S22) at
         r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone); the
         pairs from the cell walk, or with ``from_list`` from the density pass's list (module
         docstring). With the relative Courant limit, the largest |u_j - u_i| of the pairs:
         per particle into scratch_float, then reduced per block and over the blocks."""
         if ti.static(self._walks):
-            visc = self.coef.nu[None] * (2.0 * self.dim) / (
+            visc = self.coef.nu[None] * ti.static(self.viscous.factor(self.dim)) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
@@ -230,10 +233,12 @@ class Predictor:
                     if ti.static(self.lists_close_pairs):
                         self.close_count[i] = acc.close
                     if ti.static(self.model.plane_floor):
-                        # the floor's wall layer, u_j = 0 (S12 summed in plane_floor.py)
-                        v_floor = self.floor.at(self.state.pos[i][self.dim - 1])[FLOOR_V]
+                        # the floor's wall layer, u_j = 0 (S12 / V1 summed in plane_floor.py)
+                        floor_sums = self.floor.at(self.state.pos[i][self.dim - 1])
+                        v_floor = floor_sums[FLOOR_V]
                         if ti.static(self.model.viscosity):
-                            acc.visc -= self.state.vel[i] * v_floor
+                            acc.visc += self.viscous.floor(self.state.vel[i], v_floor,
+                                                           floor_sums[FLOOR_VN])
                         if ti.static(self.measures_relative_speed):
                             if v_floor > 0.0:
                                 acc.rel2 = ti.max(acc.rel2, self.state.vel[i].dot(

@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 from typing import Dict, Optional, Tuple
 
-from .params import Model, Numerics, ParameterError, Physics
+from .params import VISCOUS_STIFFNESS, Model, Numerics, ParameterError, Physics
 
 # (new names go last: RunStats.bound_log stores their index, and checkpoints keep it)
 LIMIT_NAMES = ("courant", "acoustic", "viscous", "capillary", "dt_max", "approach")
@@ -20,7 +20,8 @@ def limits(physics: Physics, numerics: Numerics, model: Model, speed: float,
                                  (measured by the predictor's walk, terms.py)
     approach:  C_a l0 / v        (with the relative speed only; terms.py says why)
     acoustic:  C_c l0 / c        (S6, S8)
-    viscous:   k_nu l0^2 / nu    (M1; only when viscosity is compiled in)
+    viscous:   k_nu l0^2 / (s nu) (M1; only when viscosity is compiled in; s the viscosity
+                                 member's stiffness, params.VISCOUS_STIFFNESS)
     capillary: k_st sqrt(rho l0^3 / (2 pi sigma))  (M1; only with surface tension)
     """
     l0 = physics.l0
@@ -32,7 +33,8 @@ def limits(physics: Physics, numerics: Numerics, model: Model, speed: float,
     if numerics.courant_speed == "relative":
         out["approach"] = numerics.approach * l0 / speed if speed > 0 else math.inf
     if model.viscosity:
-        out["viscous"] = numerics.viscous * l0 * l0 / physics.nu
+        out["viscous"] = numerics.viscous * l0 * l0 / (
+            physics.nu * VISCOUS_STIFFNESS[numerics.viscosity])
     if model.surface_tension:
         out["capillary"] = numerics.capillary * math.sqrt(
             physics.rho * l0 ** 3 / (2.0 * math.pi * physics.sigma))
@@ -49,7 +51,8 @@ def l0_at_dt(name: str, physics: Physics, numerics: Numerics, dt: float) -> floa
     if name == "acoustic":
         return dt * physics.c / numerics.acoustic
     if name == "viscous":
-        return math.sqrt(dt * physics.nu / numerics.viscous)
+        return math.sqrt(dt * physics.nu * VISCOUS_STIFFNESS[numerics.viscosity]
+                         / numerics.viscous)
     if name == "capillary":
         return ((dt / numerics.capillary) ** 2 * 2.0 * math.pi * physics.sigma
                 / physics.rho) ** (1.0 / 3.0)

@@ -346,7 +346,8 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 # which kept a first `--quick` (an empty Taichi cache) past 5 minutes (issue 26). Not in the
 # quick set: the crown's untrimmed film (11 times the particles) and its Courant limit on
 # relative speeds (another 3D model; the stability suite's -relative cases run it in 2D), and
-# the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it).
+# the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it), and
+# the oscillating drops' viscosity=central (another model; tests/test_viscosity.py holds it).
 QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "dam-break-2d": "gradient=sum", "dam-break-3d": "safety/2",
                  "drop-oscillation-2d": "gradient=seed", "drop-oscillation-3d": "safety/2",
@@ -389,6 +390,8 @@ def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
         return replace(numerics, courant=numerics.courant / 2, acoustic=numerics.acoustic / 2)
     if variant.startswith("gradient="):
         return replace(numerics, pressure_gradient=variant.split("=", 1)[1])
+    if variant.startswith("viscosity="):   # the viscosity member (core/viscosity.py)
+        return replace(numerics, viscosity=variant.split("=", 1)[1])
     if variant == "plane-floor":        # the analytic floor instead of its particle layers
         return replace(numerics, wall_model="plane")
     if variant == "relative-courant":   # the crown presets' Courant limit (core/terms.py)

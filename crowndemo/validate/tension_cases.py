@@ -5,7 +5,9 @@ drop-oscillation-*) stay as they are, beside these.
 
 The drops run with the ``sum`` gradient form (M2), the momentum-conserving one: with it the
 model conserves momentum pair by pair, so a free drop cannot drift. ``gradient=pmin`` and
-``gradient=seed`` are the variants that show what the other forms do.
+``gradient=seed`` are the variants that show what the other forms do. The oscillating drops'
+``viscosity=central`` runs the viscosity member that dissipates Lamb's rate at a free surface
+(core/viscosity.py; the base keeps the seed's Laplacian, whose share is half of it).
 """
 from __future__ import annotations
 
@@ -179,8 +181,8 @@ def _oscillation(dim: int) -> Case:
                 "surface stress: mode-2 angular frequency [rad/s]",
                 "Rayleigh-Lamb (method.md §7)", "R/l0",
                 (8, 12, 16) if dim == 2 else (8, 10, 12), (8,), lambda s: R / s, run,
-                variants=("gradient=pmin", "safety/2") + (("lattice",) if dim == 3 else ()),
-                base=stress_numerics)
+                variants=("gradient=pmin", "safety/2") + (("lattice",) if dim == 3 else ())
+                + ("viscosity=central",), base=stress_numerics)
 
 
 def _free_drop(dim: int) -> Case:
