@@ -92,9 +92,9 @@ def test_quick_plan_keeps_every_case_with_one_variant():
     every = {v for c in table.values() for v in c.variants}
     # left out of the quick set (cases.QUICK_VARIANT): the crown's two costly ones, the 3D
     # drops' lattice start (a 3D drop's minute for a start the full suite measures) and the
-    # oscillating drops' central viscosity (a model compiled for a study's variant;
+    # oscillating drops' seed viscosity (another model compiled for a variant;
     # tests/test_viscosity.py holds the member itself)
-    assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=central"}
+    assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=laplacian"}
     assert set(cases.QUICK_VARIANT) == set(table) - {"crown-base-3m-drop"}
 
 

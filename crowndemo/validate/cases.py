@@ -347,7 +347,8 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 # quick set: the crown's untrimmed film (11 times the particles) and its Courant limit on
 # relative speeds (another 3D model; the stability suite's -relative cases run it in 2D), and
 # the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it), and
-# the oscillating drops' viscosity=central (another model; tests/test_viscosity.py holds it).
+# the oscillating drops' viscosity=laplacian (another model; tests/test_viscosity.py holds
+# the member).
 QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "dam-break-2d": "gradient=sum", "dam-break-3d": "safety/2",
                  "drop-oscillation-2d": "gradient=seed", "drop-oscillation-3d": "safety/2",

@@ -111,7 +111,7 @@ def plot(rows: Sequence, path: str) -> Optional[str]:
     fig, ax = plt.subplots(figsize=(10, 5.5))
     markers = {"f64": "s", "safety/2": "^", "gradient=sum": "D", "gradient=seed": "v",
                "untrimmed": "P", "plane-floor": "<", "relative-courant": ">",
-               "lattice": "x", "viscosity=central": "*"}
+               "lattice": "x", "viscosity=laplacian": "*"}
     styles = case_styles(cases)
     for name, rs in sorted(cases.items()):
         colour, line = styles[name]
