@@ -35,6 +35,7 @@ from typing import Dict
 
 import taichi as ti
 
+from .operators import laplacian_pair
 from .params import VISCOSITY_MODELS
 
 
@@ -48,7 +49,7 @@ class LaplacianViscosity:
     @staticmethod
     @ti.func
     def pair(du, rij, r2, w):
-        return du * w
+        return laplacian_pair(du, w)
 
     @staticmethod
     @ti.func
