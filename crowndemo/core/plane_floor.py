@@ -44,11 +44,11 @@ FLOOR_SUMS = 6
 def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAMPLES,
                  reach: Optional[float] = None) -> Tuple[float, float, np.ndarray]:
     """(s0, ds, table[samples, FLOOR_SUMS]): n_floor, g_floor (the component along the last
-    axis), v_floor, c_floor, d_floor (along the last axis) and vn_floor at s = s0 + k ds, from s0 = -l0/4 (closer, the
-    collision model has acted; the table holds its last value) to reach - l0/2 (beyond, no
-    floor point is within reach). ``reach``: the widest walk, re (the default) or, for the
-    surface stress, its pair support H (Model.wide_walk): d_floor is summed within H but
-    tabulated only as far as the walks reach."""
+    axis), v_floor, c_floor, d_floor (along the last axis) and vn_floor at s = s0 + k ds,
+    from s0 = -l0/4 (closer, the collision model has acted; the table holds its last value)
+    to reach - l0/2 (beyond, no floor point is within reach). ``reach``: the widest walk, re
+    (the default) or, for the surface stress, its pair support H (Model.wide_walk): d_floor
+    is summed within H but tabulated only as far as the walks reach."""
     h = stress_pair_support(l0)
     reach = re if reach is None else reach
     s0, s1 = -0.25 * l0, reach - 0.5 * l0
@@ -98,8 +98,8 @@ class PlaneFloor:
 
     @ti.func
     def at(self, s):
-        """(n_floor, g_floor, v_floor, c_floor, d_floor, vn_floor) at height s, linear between samples;
-        zero past the top."""
+        """(n_floor, g_floor, v_floor, c_floor, d_floor, vn_floor) at height s, linear between
+        samples; zero past the top."""
         # clamped before the cast: a height far up (or inf, NaN) would cast to INT_MIN
         x = ti.min((ti.max(s, self.s0[None]) - self.s0[None]) * self.inv_ds[None],
                    float(SAMPLES - 1))

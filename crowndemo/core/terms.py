@@ -208,11 +208,12 @@ class Predictor:
 
     @ti.kernel
     def _forces(self, from_list: ti.i32):
-        """a* = nu <lap u> (the viscosity member's, S12 or V1) + g + (C/m) sum of minus the potential's gradient (S14, S22) at
-        r^k, into scratch_vec (no work without a walk: ``accelerate`` adds g alone); the
-        pairs from the cell walk, or with ``from_list`` from the density pass's list (module
-        docstring). With the relative Courant limit, the largest |u_j - u_i| of the pairs:
-        per particle into scratch_float, then reduced per block and over the blocks."""
+        """a* = nu <lap u> (the viscosity member's, S12 or V1) + g + (C/m) sum of minus the
+        potential's gradient (S14, S22) at r^k, into scratch_vec (no work without a walk:
+        ``accelerate`` adds g alone); the pairs from the cell walk, or with ``from_list``
+        from the density pass's list (module docstring). With the relative Courant limit,
+        the largest |u_j - u_i| of the pairs: per particle into scratch_float, then reduced
+        per block and over the blocks."""
         if ti.static(self._walks):
             visc = self.coef.nu[None] * ti.static(self.viscous.factor(self.dim)) / (
                 self.coef.lambda0[None] * self.coef.n0[None])
