@@ -22,11 +22,11 @@ import pytest
 
 from crowndemo import backend
 from crowndemo.core import FLUID, Numerics, Physics, Simulator
-from crowndemo.core.lattice import n0_lambda0
-from crowndemo.core.params import VISCOUS_STIFFNESS, ParameterError, with_values
+from crowndemo.core.lattice import lattice_offsets, n0_lambda0, weight
+from crowndemo.core.params import (VISCOUS_STIFFNESS, Model, ParameterError,
+                                   with_values)
 from crowndemo.core.plane_floor import FLOOR_V, FLOOR_VN, floor_tables
 from crowndemo.core.timestep import limits
-from crowndemo.core.params import Model
 
 L0 = 2.0 ** -9
 RE_RATIO = 2.1
@@ -64,15 +64,11 @@ def _lattice(dim: int):
 
 def _moments(dim: int):
     """m4 = sum_j w x^4 / r^2 and m22 = sum_j w x^2 z^2 / r^2 on the lattice (in l0^2)."""
-    m4 = m22 = 0.0
-    for q in itertools.product(range(-3, 4), repeat=dim):
-        q = np.array(q, dtype=float)
-        r = np.linalg.norm(q)
-        if 0.0 < r < RE_RATIO:
-            w = RE_RATIO / r - 1.0
-            m4 += w * q[0] ** 4 / r ** 2
-            m22 += w * q[0] ** 2 * q[-1] ** 2 / r ** 2
-    return m4, m22
+    q = lattice_offsets(dim, 1.0, RE_RATIO)
+    r2 = (q * q).sum(axis=1)
+    w = weight(np.sqrt(r2), RE_RATIO)
+    return float((w * q[:, 0] ** 4 / r2).sum()), float((w * q[:, 0] ** 2 * q[:, -1] ** 2
+                                                        / r2).sum())
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -103,12 +99,14 @@ def test_quadratic_fields_on_the_lattice(dim, profile):
         assert np.abs(a[:, 1:]).max() <= tol, name
 
 
-def _disordered_ball(dim: int, radius_l0: float = 5.0, seed: int = 3) -> np.ndarray:
+def _disordered_ball(dim: int, radius_l0: float = 5.0, seed: int = 3,
+                     jitter: float = 0.2) -> np.ndarray:
+    """The lattice points within radius_l0 l0, each moved by up to jitter l0 along each axis."""
     rng = np.random.default_rng(seed)
     m = int(radius_l0) + 1
     ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
     ks = ks[np.linalg.norm(ks, axis=1) <= radius_l0]
-    return (ks + rng.uniform(-0.2, 0.2, ks.shape)) * L0
+    return (ks + rng.uniform(-jitter, jitter, ks.shape)) * L0
 
 
 def _rotation(dim: int, pos: np.ndarray, omega: float) -> np.ndarray:
@@ -191,10 +189,9 @@ def test_viscous_limit_follows_the_members_stiffness():
     assert lim["central"] == pytest.approx(lim["laplacian"] / VISCOUS_STIFFNESS["central"],
                                            rel=1e-12)
     for dim in (2, 3):
-        pts = np.array([q for q in itertools.product(range(-3, 4), repeat=dim)
-                        if 0 < np.dot(q, q) < RE_RATIO ** 2], dtype=float)
+        pts = lattice_offsets(dim, 1.0, RE_RATIO)
         r = np.linalg.norm(pts, axis=1)
-        w, e = RE_RATIO / r - 1.0, pts / r[:, None]
+        w, e = weight(r, RE_RATIO), pts / r[:, None]
         top = [0.0, 0.0]
         for k in itertools.product(np.linspace(0.0, np.pi, 9), repeat=dim):
             c = w * (1.0 - np.cos(pts @ np.array(k)))
@@ -223,11 +220,7 @@ def test_mode2_flow_dissipation_against_lambs(radius_l0):
     and above, 1 + 0.05 for the central form on the lattice's fourth moment (m4 / 3 m22 =
     1.11; up to +3 % measured on the lattice cut)."""
     dim = 3
-    rng = np.random.default_rng(0)
-    m = radius_l0 + 1
-    ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
-    ks = ks[np.linalg.norm(ks, axis=1) <= radius_l0]
-    pos = (ks + rng.uniform(-0.15, 0.15, ks.shape)) * L0
+    pos = _disordered_ball(dim, radius_l0, seed=0, jitter=0.15)
     gamma = 10.0                                          # 1/s
     G = gamma * np.diag([-1.0, -1.0, 2.0])
     vel = pos @ G.T
