@@ -1,0 +1,95 @@
+"""tools/mode_power_study.py's numpy forces (VALIDATION.md "Where the mode's energy goes"): the
+split of the mode's energy among the forces is only as good as these sums, so they are held to
+the method's exact values and to the step's own kernel:
+
+- its pairs are every pair closer than re, each once;
+- the sum form (method.md M2) of a linear pressure field on the perfect lattice is -grad P /
+  rho exactly in the interior (the lattice's second moment, sum_j w x^2 / r^2 = n0 / d), of a
+  uniform one zero, and its pair forces are equal and opposite (momentum kept) for any P;
+- its viscous terms (V1, S12) are the predictor's on a disordered ball, to float rounding.
+"""
+import importlib.util
+import itertools
+import os
+
+import numpy as np
+import pytest
+
+from crowndemo import backend
+from crowndemo.core import FLUID, Numerics, Physics, Simulator
+from crowndemo.core.params import with_values
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_spec = importlib.util.spec_from_file_location(
+    "mode_power_study", os.path.join(ROOT, "tools", "mode_power_study.py"))
+tool = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(tool)
+
+L0 = 2.0 ** -9
+RE_RATIO = 2.1
+RHO = 1000.0
+NU = 1.0e-3
+
+
+def _simulator(dim: int, count: int, viscosity: str) -> Simulator:
+    physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, rho=RHO, nu=NU, sigma=0.0,
+                      gravity=0.0, sound_speed=5.0)
+    numerics = with_values(Numerics(), viscosity=viscosity, pressure_gradient="sum",
+                           collision=0.0)
+    sim = Simulator(physics, numerics, count)
+    sim.configure(physics, numerics, (tuple([-1.0] * dim), tuple([1.0] * dim)))
+    return sim
+
+
+def _ball(dim: int, radius_l0: float, jitter: float, seed: int = 1) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    m = int(radius_l0) + 1
+    ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
+    ks = ks[np.linalg.norm(ks, axis=1) <= radius_l0]
+    return (ks + rng.uniform(-jitter, jitter, ks.shape)) * L0
+
+
+def test_pairs_are_every_pair_within_re_once():
+    x = np.random.default_rng(0).uniform(0.0, 10 * L0, (300, 3))
+    re = RE_RATIO * L0
+    i, j, rij, r = tool.pairs_within(x, re, chunk=64)
+    found = set(zip(i.tolist(), j.tolist()))
+    d = np.linalg.norm(x[:, None] - x[None], axis=2)
+    brute = {(a, b) for a, b in zip(*np.nonzero(d < re)) if a < b}
+    assert found == brute and len(i) == len(found)
+    np.testing.assert_allclose(rij, x[j] - x[i])
+    np.testing.assert_allclose(r, d[i, j])
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_sum_form_of_a_linear_pressure_is_its_gradient(dim):
+    sim = _simulator(dim, 8, "central")
+    m = 6 if dim == 2 else 4
+    x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
+    interior = np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
+    k = np.arange(1.0, dim + 1.0) * 1.0e5                       # grad P [Pa/m]
+    zero = np.zeros_like(x)
+    acc = tool.forces(sim, x, zero, 50.0 + x @ k, "central")["pressure"]
+    np.testing.assert_allclose(acc[interior], np.tile(-k / RHO, (interior.sum(), 1)),
+                               rtol=1e-9)
+    uniform = tool.forces(sim, x, zero, np.full(len(x), 50.0), "central")["pressure"]
+    np.testing.assert_allclose(uniform[interior], 0.0, atol=1e-9 * np.abs(k / RHO).max())
+    p = np.random.default_rng(2).uniform(0.0, 100.0, len(x))
+    total = tool.forces(sim, x, zero, p, "central")["pressure"].sum(axis=0)
+    scale = np.abs(tool.forces(sim, x, zero, p, "central")["pressure"]).max()
+    np.testing.assert_allclose(total, 0.0, atol=1e-12 * scale * len(x))
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("viscosity", ["central", "laplacian"])
+def test_viscous_terms_are_the_predictors(dim, viscosity):
+    x = _ball(dim, 4.0, 0.15)
+    v = np.random.default_rng(3).normal(0.0, 0.1, x.shape)
+    sim = _simulator(dim, len(x), viscosity)
+    sim.load(x, v, np.full(len(x), FLUID, dtype=np.int32))
+    sim.grid.build(RE_RATIO * L0)            # no re-sort: field index i = i-th particle
+    sim.predictor.forces()
+    kernel = sim.state.scratch_vec.to_numpy()[: len(x)].astype(float)
+    numpy_sum = tool.forces(sim, x, v, np.zeros(len(x)), viscosity)["viscosity"]
+    rtol = 1e-10 if backend.is_f64() else 2e-4
+    np.testing.assert_allclose(numpy_sum, kernel, rtol=rtol, atol=rtol * np.abs(kernel).max())

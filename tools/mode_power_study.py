@@ -1,0 +1,210 @@
+"""Where the oscillating drop's mode-2 energy goes, force by force and layer by layer (issue 23,
+VALIDATION.md "Where the mode's energy goes"), reproducible:
+
+    .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
+                          [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
+                          [--re-ratio X] [--threads N]
+
+The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
+numerics with V1, nu = 1e-5 unless --nu), run P mode-2 periods (default 5). With --kick K the
+mode's start velocity (scenes/drop.oscillating_drop's, amplitude 0.1) is added once more at
+K periods, to the drop as it then is: a second start on a liquid that has oscillated and
+settled, without the first start's melt. --sound-factor S: the drop's sound speed times S;
+--re-ratio X: re = X l0 (the case's 2.1). F frames a period (default 40); at each:
+
+- the mode's flow: the drop's velocities about their mean fitted by a linear field v = G d;
+  G's symmetric traceless part is mode 2's flow u_m (exactly, for a linear mode); E_m, its
+  kinetic energy;
+- each force's power on that flow, m sum_i a_i . u_m(x_i): the pressure gradient (the sum
+  form, method.md M2, of the frame's EOS pressure, S21), the viscous term (V1 or S12, method.md
+  §3b, of the frame's velocities), the surface stress (the member's a_i of the last step);
+  and each split by layer: the free surface (n < beta n0), and the fluid under it at depth
+  < 1.5 l0, 1.5-2.5 l0 and deeper (the distance to the nearest free-surface particle).
+
+Per period: each force's work on the mode's flow over the period, over the period's mean
+E_m (a loss at Lamb's rate gamma is -4 gamma T of it; the period that ends at the kick has
+it in its last frame and is not read), its mean over the periods from the kick (or the
+first) on, force by force and layer by layer, and the decay read from the peaks of
+E_m, one a half period: gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T) over the periods
+from the kick (or from the first) on. numpy over the pairs within re (a few thousand
+particles: seconds a frame); the pressure and the stress are those of the frame's positions
+and the last step's r*, so the split is a diagnostic, not the step's own bookkeeping.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+from dataclasses import replace
+from typing import Dict, Tuple
+
+import numpy as np
+import yaml
+
+
+def pairs_within(x: np.ndarray, re: float, chunk: int = 512) -> Tuple[np.ndarray, ...]:
+    """(i, j, r_ij = x_j - x_i, |r_ij|) for every pair i < j closer than re."""
+    out_i, out_j = [], []
+    for a in range(0, len(x), chunk):
+        d = x[None, :, :] - x[a:a + chunk, None, :]
+        r2 = (d * d).sum(axis=2)
+        ii, jj = np.nonzero(r2 < re * re)
+        ii = ii + a
+        keep = jj > ii
+        out_i.append(ii[keep])
+        out_j.append(jj[keep])
+    i, j = np.concatenate(out_i), np.concatenate(out_j)
+    rij = x[j] - x[i]
+    return i, j, rij, np.linalg.norm(rij, axis=1)
+
+
+def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float) -> np.ndarray:
+    """sum_j f_ij over both members of each pair: f on i, sign f on j (f_ji = sign f_ij)."""
+    out = np.zeros((n,) + f_ij.shape[1:])
+    np.add.at(out, i, f_ij)
+    np.add.at(out, j, sign * f_ij)
+    return out
+
+
+def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray, viscosity: str) -> Dict[str, np.ndarray]:
+    """The pressure gradient (sum form, M2), the viscous term (V1 / S12) and their pair
+    neighbourhoods' number density, numpy over the pairs within re [m/s^2]."""
+    from crowndemo.core.lattice import weight
+    lat, ph = sim.lattice, sim.physics
+    dim, re, n0, rho = ph.dim, lat.re, lat.n0, ph.rho
+    i, j, rij, r = pairs_within(x, re)
+    w = weight(r, re)
+    n = len(x)
+    # M2: a_i = -d / (n0 rho) sum_j (P_i + P_j) r_ij w / r^2, r_ij = x_j - x_i (antisymmetric)
+    acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, ((p[i] + p[j]) * w / r ** 2)[:, None] * rij, -1)
+    du = v[j] - v[i]
+    if viscosity == "central":      # V1: nu 2d(d+2)/(lambda n0) sum ((du . r) r / r^2) w
+        f = ((du * rij).sum(axis=1) * w / r ** 2)[:, None] * rij
+        acc_v = ph.nu * 2 * dim * (dim + 2) / (lat.lambda0 * n0) * pair_sum(n, i, j, f, -1)
+    else:                           # S12: nu 2d/(lambda n0) sum (u_j - u_i) w
+        acc_v = ph.nu * 2 * dim / (lat.lambda0 * n0) * pair_sum(n, i, j, du * w[:, None], -1)
+    number_density = pair_sum(n, i, j, w, 1)
+    return {"pressure": acc_p, "viscosity": acc_v, "n": number_density}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("dim", type=int, choices=(2, 3))
+    ap.add_argument("scale", type=float, metavar="R/l0")
+    ap.add_argument("--periods", type=float, default=5.0)
+    ap.add_argument("--kick", type=float, default=0.0, metavar="K")
+    ap.add_argument("--nu", type=float, default=None)
+    ap.add_argument("--frames", type=int, default=40, metavar="F")
+    ap.add_argument("--numerics", action="append", default=[], metavar="KEY=VALUE")
+    ap.add_argument("--sound-factor", type=float, default=1.0)
+    ap.add_argument("--re-ratio", type=float, default=None, help="re / l0 (default: the case's)")
+    ap.add_argument("--threads", type=int, default=1)
+    a = ap.parse_args()
+    from crowndemo import backend
+    backend.init("cpu", threads=a.threads)
+    from crowndemo.core import Numerics
+    from crowndemo.core.state import FLUID
+    from crowndemo.scenes.drop import drop_sound_speed, oscillating_drop
+    from crowndemo.core.params import WATER
+    from crowndemo.validate import tension_cases as tc
+    from crowndemo.validate.cases import simulator
+
+    numerics = tc.oscillation_numerics(Numerics())
+    for kv in a.numerics:
+        key, value = kv.split("=", 1)
+        numerics = replace(numerics, **{key: yaml.safe_load(value)})
+    numerics = numerics.validate("--numerics")
+    l0 = tc.R / a.scale
+    nu = tc.OSCILLATION_NU if a.nu is None else a.nu
+    c = drop_sound_speed(l0, WATER["sigma"], WATER["rho"]) * a.sound_factor
+    scene = oscillating_drop(dim=a.dim, radius=tc.R, l0=l0, nu=nu, periods=a.periods,
+                             numerics=numerics, disorder=tc.DISORDER[a.dim], sound_speed=c)
+    if a.re_ratio is not None:
+        scene = replace(scene, physics=replace(scene.physics, re_ratio=a.re_ratio).validate())
+    period, lamb = scene.info["period_s"], scene.info["decay_1_s"]
+    start_u = scene.vel[scene.kind == FLUID].copy()
+    start_x = scene.pos[scene.kind == FLUID]
+    G0 = np.linalg.lstsq(start_x - start_x.mean(axis=0), start_u, rcond=None)[0].T
+    sim = simulator(scene)
+    mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
+    kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1
+    layers = ("surface", "under 1.5 l0", "1.5-2.5 l0", "deeper")
+    rows = []
+
+    def on_frame(s, index: int) -> None:
+        if index == kick_frame:         # the start's mode velocity once more, about the centre
+            st = s.state
+            count = st.count
+            pos, vel = st.pos.to_numpy(), st.vel.to_numpy()
+            fluid = st.kind.to_numpy()[:count] == FLUID
+            d = pos[:count][fluid] - pos[:count][fluid].mean(axis=0)
+            block = vel[:count]
+            block[fluid] += (d @ G0.T).astype(vel.dtype)
+            vel[:count] = block
+            st.vel.from_numpy(vel)
+        s.refresh_pressure()
+        snap = s.snapshot()
+        fluid = snap["kind"] == FLUID
+        x, v, p = (snap[k][fluid].astype(float) for k in ("pos", "vel", "pressure"))
+        d, u = x - x.mean(axis=0), v - v.mean(axis=0)
+        G = np.linalg.lstsq(d, u, rcond=None)[0].T
+        Gs = 0.5 * (G + G.T)
+        Gs -= np.trace(Gs) / a.dim * np.eye(a.dim)
+        um = d @ Gs.T
+        acc = forces(s, x, v, p, numerics.viscosity)
+        order = np.argsort(s.state.pid.to_numpy()[:s.state.count], kind="stable")
+        acc["stress"] = s.surface_tension.accel.to_numpy()[:s.state.count][order][fluid]
+        surface = acc.pop("n") < beta * s.lattice.n0
+        depth = np.full(len(x), np.inf)
+        if surface.any():
+            for k in range(0, len(x), 512):
+                depth[k:k + 512] = np.sqrt(((x[k:k + 512, None] - x[None, surface]) ** 2)
+                                           .sum(axis=2)).min(axis=1)
+        masks = (surface, ~surface & (depth < 1.5 * l0),
+                 ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0), ~surface & (depth >= 2.5 * l0))
+        row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum())}
+        for name, a_i in acc.items():
+            power = mass * (a_i * um).sum(axis=1)
+            row[name] = float(power.sum())
+            for layer, m in zip(layers, masks):
+                row[(name, layer)] = float(power[m].sum())
+        rows.append(row)
+
+    frames = np.linspace(0.0, scene.t_end, int(round(a.frames * a.periods)) + 1)
+    sim.run(scene.t_end, frame_times=frames, on_frame=on_frame)
+    t = np.array([r["t"] for r in rows])
+    E = np.array([r["E_m"] for r in rows])
+    names = ("pressure", "viscosity", "stress")
+    print(f"{a.dim}D drop, R/l0 = {a.scale:g}, {int(scene.kind.size)} particles, nu = {nu:g}, "
+          f"c = {c:.3g} m/s, {numerics.viscosity} viscosity; T = {period * 1e3:.3f} ms, "
+          f"Lamb's decay {lamb:.1f} 1/s (a loss of {4 * lamb * period:.2f} mean E_m a period)"
+          + (f"; kicked at {a.kick:g} T" if a.kick > 0 else ""))
+    print("period | work on the mode's flow / the period's mean E_m: pressure, viscosity, stress, "
+          "sum | by layer (" + ", ".join(layers) + "): pressure; stress")
+    peaks, after = [], []
+    first = int(round(a.kick)) if a.kick > 0 else 0
+    for k in range(int(round(a.periods))):
+        m = (t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)
+        mean_E = E[m].mean()
+        work = {q: np.trapezoid([r[q] for r, keep in zip(rows, m) if keep], t[m]) / mean_E
+                for q in list(names) + [(q, layer) for q in names for layer in layers]}
+        peaks.append(E[m].max())
+        if k >= first:
+            after.append(work)
+        cut = " (ends at the kick: not read)" if a.kick > 0 and k == first - 1 else ""
+        print(f"{k} | {work['pressure']:+.2f} {work['viscosity']:+.2f} {work['stress']:+.2f} "
+              f"{sum(work[q] for q in names):+.2f} | "
+              + " ".join(f"{work[('pressure', layer)]:+.2f}" for layer in layers) + "; "
+              + " ".join(f"{work[('stress', layer)]:+.2f}" for layer in layers) + cut)
+    mean = {q: float(np.mean([w[q] for w in after])) for q in after[0]}
+    print(f"mean over the periods from {first}: " + ", ".join(
+        f"{q} {mean[q]:+.2f} (" + " ".join(f"{mean[(q, layer)]:+.2f}" for layer in layers) + ")"
+        for q in names) + f"; sum {sum(mean[q] for q in names):+.2f}")
+    gammas = [-math.log(peaks[k + 1] / peaks[k]) / (2 * period)
+              for k in range(first, len(peaks) - 1)]
+    print("decay from E_m's peaks, period by period from " + str(first) + ": "
+          + " ".join(f"{g:.1f}" for g in gammas)
+          + f" 1/s (mean {np.mean(gammas):.1f}; Lamb's {lamb:.1f})")
+
+
+if __name__ == "__main__":
+    main()
