@@ -12,9 +12,9 @@ K periods, to the drop as it then is: a second start on a liquid that has oscill
 settled, without the first start's melt. --sound-factor S: the drop's sound speed times S;
 --re-ratio X: re = X l0 (the case's 2.1). F frames a period (default 40); at each:
 
-- the mode's flow: the drop's velocities about their mean fitted by a linear field v = G d;
-  G's symmetric traceless part is mode 2's flow u_m (exactly, for a linear mode); E_m, its
-  kinetic energy;
+- the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
+  mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
+  (exactly, for a linear mode); E_m, its kinetic energy;
 - each force's power on that flow, m sum_i a_i . u_m(x_i): the pressure gradient (the sum
   form, method.md M2, of the frame's EOS pressure, S21), the viscous term (V1 or S12, method.md
   §3b, of the frame's velocities), the surface stress (the member's a_i of the last step);
@@ -65,9 +65,10 @@ def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float
     return out
 
 
-def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray, viscosity: str) -> Dict[str, np.ndarray]:
-    """The pressure gradient (sum form, M2), the viscous term (V1 / S12) and their pair
-    neighbourhoods' number density, numpy over the pairs within re [m/s^2]."""
+def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
+           viscosity: str) -> Dict[str, np.ndarray]:
+    """The pressure gradient (sum form, M2) and the viscous term (V1 / S12) [m/s^2], and the
+    number density (S9, "n"), numpy over the pairs within re."""
     from crowndemo.core.lattice import weight
     lat, ph = sim.lattice, sim.physics
     dim, re, n0, rho = ph.dim, lat.re, lat.n0, ph.rho
@@ -160,7 +161,8 @@ def main() -> None:
                 depth[k:k + 512] = np.sqrt(((x[k:k + 512, None] - x[None, surface]) ** 2)
                                            .sum(axis=2)).min(axis=1)
         masks = (surface, ~surface & (depth < 1.5 * l0),
-                 ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0), ~surface & (depth >= 2.5 * l0))
+                 ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0),
+                 ~surface & (depth >= 2.5 * l0))
         row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum())}
         for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
