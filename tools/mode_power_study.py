@@ -23,12 +23,13 @@ settled, without the first start's melt. --sound-factor S: the drop's sound spee
 
 Per period: each force's work on the mode's flow over the period, over the period's mean
 E_m (a loss at Lamb's rate gamma is -4 gamma T of it; the period that ends at the kick has
-it in its last frame and is not read), its mean over the periods from the kick (or the
-first) on, force by force and layer by layer, and the decay read from the peaks of
-E_m, one a half period: gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T) over the periods
-from the kick (or from the first) on. numpy over the pairs within re (a few thousand
-particles: seconds a frame); the pressure and the stress are those of the frame's positions
-and the last step's r*, so the split is a diagnostic, not the step's own bookkeeping.
+it in its last frame and is not read). Over the periods read (from the kick on; without
+one, from where the case's fit starts: the second period in 3D, the first in 2D): each
+force's mean work, layer by layer; the decay from the peaks of E_m, one a half period,
+gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T); and the deformation's fit (the case's,
+validate/oscillation.py). numpy over the pairs within re (a few thousand particles: seconds
+a frame); the pressure and the stress are those of the frame's positions and the last
+step's r*, so the split is a diagnostic, not the step's own bookkeeping.
 """
 from __future__ import annotations
 
@@ -106,6 +107,7 @@ def main() -> None:
     from crowndemo.core.state import FLUID
     from crowndemo.scenes.drop import drop_sound_speed, oscillating_drop
     from crowndemo.core.params import WATER
+    from crowndemo.validate import oscillation
     from crowndemo.validate import tension_cases as tc
     from crowndemo.validate.cases import simulator
 
@@ -163,7 +165,8 @@ def main() -> None:
         masks = (surface, ~surface & (depth < 1.5 * l0),
                  ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0),
                  ~surface & (depth >= 2.5 * l0))
-        row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum())}
+        row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum()),
+               "deformation": oscillation.deformation(x)}
         for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
             row[name] = float(power.sum())
@@ -183,7 +186,8 @@ def main() -> None:
     print("period | work on the mode's flow / the period's mean E_m: pressure, viscosity, stress, "
           "sum | by layer (" + ", ".join(layers) + "): pressure; stress")
     peaks, after = [], []
-    first = int(round(a.kick)) if a.kick > 0 else 0
+    # read from the kick on, else where the case's fit starts (after a disordered start's melt)
+    first = int(round(a.kick)) if a.kick > 0 else (1 if tc.DISORDER[a.dim] > 0 else 0)
     for k in range(int(round(a.periods))):
         m = (t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)
         mean_E = E[m].mean()
@@ -206,6 +210,11 @@ def main() -> None:
     print("decay from E_m's peaks, period by period from " + str(first) + ": "
           + " ".join(f"{g:.1f}" for g in gammas)
           + f" 1/s (mean {np.mean(gammas):.1f}; Lamb's {lamb:.1f})")
+    fit = t >= first * period - 1e-12
+    omega, decay = oscillation.fit(t[fit], np.array([r["deformation"] for r in rows])[fit])
+    ref = scene.info["omega_rad_s"]
+    print(f"the deformation's fit from period {first} on (as the case's): {omega:.1f} rad/s "
+          f"({omega / ref - 1:+.2%} against Rayleigh's {ref:.1f}), decay {decay:.1f} 1/s")
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@ layer does" and after, issue 23), reproducible:
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
-                          [--nu NU] [--sound-factor F] [--relaxed-start P]
+                          [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
@@ -74,6 +74,7 @@ member's surface fit instead of the normals' divergence (tolman_fit_member).
 ``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``,
 ``energy``; tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound
 speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
+``--re-ratio X``: every drop's re = X l0 (the cases' 2.1; tools/mode_power_study.py);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
@@ -1115,6 +1116,8 @@ def main() -> None:
     ap.add_argument("--nu", type=float, default=None,
                     help="case stress-drop-oscillation-* and energy: the drop's kinematic "
                          "viscosity [m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
+    ap.add_argument("--re-ratio", type=float, default=None,
+                    help="every drop's re / l0 (the cases' 2.1)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
@@ -1212,6 +1215,12 @@ def main() -> None:
         from crowndemo.scenes import drop as drop_scene
         sound_speed = drop_scene.drop_sound_speed
         drop_scene.drop_sound_speed = lambda *args: a.sound_factor * sound_speed(*args)
+    if a.re_ratio is not None:
+        from dataclasses import replace as _replace
+        from crowndemo.scenes import drop as drop_scene
+        assemble = drop_scene.assemble
+        drop_scene.assemble = lambda name, physics, *rest: assemble(
+            name, _replace(physics, re_ratio=a.re_ratio).validate("--re-ratio"), *rest)
     if a.numerics:
         import yaml
         from crowndemo.core.params import with_values
