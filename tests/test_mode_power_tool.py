@@ -2,7 +2,7 @@
 split of the mode's energy among the forces is only as good as these sums, so they are held to
 the method's exact values and to the step's own kernel:
 
-- its pairs are every pair closer than re, each once;
+- its pairs (validate/clusters.close_pairs) are every pair closer than re, each once;
 - the sum form (method.md M2) of a linear pressure field on the perfect lattice is -grad P /
   rho exactly in the interior (the lattice's second moment, sum_j w x^2 / r^2 = n0 / d), of a
   uniform one zero, and its pair forces are equal and opposite (momentum kept) for any P;
@@ -18,6 +18,9 @@ import pytest
 from crowndemo import backend
 from crowndemo.core import FLUID, Numerics, Physics, Simulator
 from crowndemo.core.params import with_values
+from crowndemo.scenes.base import lattice_block
+from crowndemo.scenes.drop import disordered
+from crowndemo.validate.clusters import close_pairs
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _spec = importlib.util.spec_from_file_location(
@@ -41,24 +44,23 @@ def _simulator(dim: int, count: int, viscosity: str) -> Simulator:
     return sim
 
 
-def _ball(dim: int, radius_l0: float, jitter: float, seed: int = 1) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    m = int(radius_l0) + 1
-    ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
-    ks = ks[np.linalg.norm(ks, axis=1) <= radius_l0]
-    return (ks + rng.uniform(-jitter, jitter, ks.shape)) * L0
+def _ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
+    """The cases' drop start (scenes/drop.oscillating_drop's): a lattice ball, disordered."""
+    r = radius_l0 * L0
+    pts = lattice_block([-r] * dim, [r] * dim, L0)
+    return disordered(pts[np.linalg.norm(pts, axis=1) <= r], L0, jitter)
 
 
 def test_pairs_are_every_pair_within_re_once():
+    """The tool's pairs (validate/clusters.close_pairs): every pair closer than re, once."""
     x = np.random.default_rng(0).uniform(0.0, 10 * L0, (300, 3))
     re = RE_RATIO * L0
-    i, j, rij, r = tool.pairs_within(x, re, chunk=64)
-    found = set(zip(i.tolist(), j.tolist()))
+    i, j, d2 = close_pairs(x, re, with_d2=True)
+    found = {(min(a, b), max(a, b)) for a, b in zip(i.tolist(), j.tolist())}
     d = np.linalg.norm(x[:, None] - x[None], axis=2)
     brute = {(a, b) for a, b in zip(*np.nonzero(d < re)) if a < b}
     assert found == brute and len(i) == len(found)
-    np.testing.assert_allclose(rij, x[j] - x[i])
-    np.testing.assert_allclose(r, d[i, j])
+    np.testing.assert_allclose(np.sqrt(d2), d[i, j])
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -36,26 +36,10 @@ from __future__ import annotations
 import argparse
 import math
 from dataclasses import replace
-from typing import Dict, Tuple
+from typing import Dict
 
 import numpy as np
 import yaml
-
-
-def pairs_within(x: np.ndarray, re: float, chunk: int = 512) -> Tuple[np.ndarray, ...]:
-    """(i, j, r_ij = x_j - x_i, |r_ij|) for every pair i < j closer than re."""
-    out_i, out_j = [], []
-    for a in range(0, len(x), chunk):
-        d = x[None, :, :] - x[a:a + chunk, None, :]
-        r2 = (d * d).sum(axis=2)
-        ii, jj = np.nonzero(r2 < re * re)
-        ii = ii + a
-        keep = jj > ii
-        out_i.append(ii[keep])
-        out_j.append(jj[keep])
-    i, j = np.concatenate(out_i), np.concatenate(out_j)
-    rij = x[j] - x[i]
-    return i, j, rij, np.linalg.norm(rij, axis=1)
 
 
 def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float) -> np.ndarray:
@@ -68,24 +52,26 @@ def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float
 
 def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
            viscosity: str) -> Dict[str, np.ndarray]:
-    """The pressure gradient (sum form, M2) and the viscous term (V1 / S12) [m/s^2], and the
-    number density (S9, "n"), numpy over the pairs within re."""
+    """The pressure gradient (sum form, M2) and the viscous term (the member ``viscosity``:
+    V1 or S12) [m/s^2], numpy over the pairs within re (validate/clusters.close_pairs)."""
     from crowndemo.core.lattice import weight
+    from crowndemo.core.viscosity import member
+    from crowndemo.validate.clusters import close_pairs
     lat, ph = sim.lattice, sim.physics
     dim, re, n0, rho = ph.dim, lat.re, lat.n0, ph.rho
-    i, j, rij, r = pairs_within(x, re)
-    w = weight(r, re)
+    i, j, r2 = close_pairs(x, re, with_d2=True)
+    rij = x[j] - x[i]
+    w = weight(np.sqrt(r2), re)
     n = len(x)
     # M2: a_i = -d / (n0 rho) sum_j (P_i + P_j) r_ij w / r^2, r_ij = x_j - x_i (antisymmetric)
-    acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, ((p[i] + p[j]) * w / r ** 2)[:, None] * rij, -1)
+    acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, ((p[i] + p[j]) * w / r2)[:, None] * rij, -1)
     du = v[j] - v[i]
-    if viscosity == "central":      # V1: nu 2d(d+2)/(lambda n0) sum ((du . r) r / r^2) w
-        f = ((du * rij).sum(axis=1) * w / r ** 2)[:, None] * rij
-        acc_v = ph.nu * 2 * dim * (dim + 2) / (lat.lambda0 * n0) * pair_sum(n, i, j, f, -1)
-    else:                           # S12: nu 2d/(lambda n0) sum (u_j - u_i) w
-        acc_v = ph.nu * 2 * dim / (lat.lambda0 * n0) * pair_sum(n, i, j, du * w[:, None], -1)
-    number_density = pair_sum(n, i, j, w, 1)
-    return {"pressure": acc_p, "viscosity": acc_v, "n": number_density}
+    if viscosity == "central":      # V1's pair term: ((du . r) r / r^2) w
+        f = ((du * rij).sum(axis=1) * w / r2)[:, None] * rij
+    else:                           # S12's: (u_j - u_i) w
+        f = du * w[:, None]
+    acc_v = ph.nu * member(viscosity).factor(dim) / (lat.lambda0 * n0) * pair_sum(n, i, j, f, -1)
+    return {"pressure": acc_p, "viscosity": acc_v}
 
 
 def main() -> None:
@@ -140,9 +126,7 @@ def main() -> None:
             pos, vel = st.pos.to_numpy(), st.vel.to_numpy()
             fluid = st.kind.to_numpy()[:count] == FLUID
             d = pos[:count][fluid] - pos[:count][fluid].mean(axis=0)
-            block = vel[:count]
-            block[fluid] += (d @ G0.T).astype(vel.dtype)
-            vel[:count] = block
+            vel[:count][fluid] += (d @ G0.T).astype(vel.dtype)
             st.vel.from_numpy(vel)
         s.refresh_pressure()
         snap = s.snapshot()
@@ -156,7 +140,7 @@ def main() -> None:
         acc = forces(s, x, v, p, numerics.viscosity)
         order = np.argsort(s.state.pid.to_numpy()[:s.state.count], kind="stable")
         acc["stress"] = s.surface_tension.accel.to_numpy()[:s.state.count][order][fluid]
-        surface = acc.pop("n") < beta * s.lattice.n0
+        surface = snap["number_density"][fluid] < beta * s.lattice.n0   # M3, the step's n
         depth = np.full(len(x), np.inf)
         if surface.any():
             for k in range(0, len(x), 512):
