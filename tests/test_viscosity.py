@@ -27,25 +27,13 @@ from crowndemo.core.params import (VISCOUS_STIFFNESS, Model, ParameterError,
                                    with_values)
 from crowndemo.core.plane_floor import FLOOR_V, FLOOR_VN, floor_tables
 from crowndemo.core.timestep import limits
+from viscous_probe import L0, NU, RE_RATIO, fourth_moments, probe_simulator
 
-L0 = 2.0 ** -9
-RE_RATIO = 2.1
-NU = 1.0e-3
 HALF = {2: 7, 3: 5}
 
 
 def rtol() -> float:
     return 1e-12 if backend.is_f64() else 2e-5
-
-
-def _simulator(dim: int, pos: np.ndarray, viscosity: str) -> Simulator:
-    physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=NU, sigma=0.0,
-                      gravity=0.0, sound_speed=5.0)
-    numerics = with_values(Numerics(), viscosity=viscosity, pressure_gradient="sum",
-                           collision=0.0)
-    sim = Simulator(physics, numerics, len(pos))
-    sim.configure(physics, numerics, (tuple([-1.0] * dim), tuple([1.0] * dim)))
-    return sim
 
 
 def _accelerations(sim: Simulator, pos: np.ndarray, vel: np.ndarray) -> np.ndarray:
@@ -62,15 +50,6 @@ def _lattice(dim: int):
     return ks * L0, interior
 
 
-def _moments(dim: int):
-    """m4 = sum_j w x^4 / r^2 and m22 = sum_j w x^2 z^2 / r^2 on the lattice (in l0^2)."""
-    q = lattice_offsets(dim, 1.0, RE_RATIO)
-    r2 = (q * q).sum(axis=1)
-    w = weight(np.sqrt(r2), RE_RATIO)
-    return float((w * q[:, 0] ** 4 / r2).sum()), float((w * q[:, 0] ** 2 * q[:, -1] ** 2
-                                                        / r2).sum())
-
-
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("profile", ["z2", "x2"])
 def test_quadratic_fields_on_the_lattice(dim, profile):
@@ -82,7 +61,7 @@ def test_quadratic_fields_on_the_lattice(dim, profile):
     vel = np.zeros_like(pos)
     vel[:, 0] = (pos[:, axis] / L0) ** 2 * 1e-3
     n0, lambda0 = n0_lambda0(dim, L0, RE_RATIO * L0)
-    m4, m22 = _moments(dim)
+    m4, m22 = fourth_moments(dim)
     scale = NU * 1e-3 / L0 ** 2
     expected = {"laplacian": 2.0 * scale,
                 "central": scale * 2 * dim * (dim + 2) / (lambda0 / L0 ** 2 * n0)
@@ -92,7 +71,7 @@ def test_quadratic_fields_on_the_lattice(dim, profile):
     assert (m4 + (dim - 1) * m22) == pytest.approx(lambda0 / L0 ** 2 * n0 / dim, rel=1e-12)
     assert abs(m22 / iso_m22 - 1.0) < 0.15 and abs(m4 / (3 * iso_m22) - 1.0) < 0.15
     for name, a_x in expected.items():
-        sim = _simulator(dim, pos, name)
+        sim = probe_simulator(dim, len(pos), name)
         a = _accelerations(sim, pos, vel)[interior]
         tol = rtol() * scale * HALF[dim] ** 2 * 10
         assert np.abs(a[:, 0] - a_x).max() <= tol, name
@@ -124,8 +103,8 @@ def test_a_rigid_motion_feels_no_central_viscosity(dim):
     omega = 100.0                                  # rad/s: surface speed 0.1 m/s at 1 mm
     vel = _rotation(dim, pos, omega) + 0.05
     scale = NU * omega / L0                        # the Laplacian's size at the surface
-    a_central = _accelerations(_simulator(dim, pos, "central"), pos, vel)
-    a_laplacian = _accelerations(_simulator(dim, pos, "laplacian"), pos, vel)
+    a_central = _accelerations(probe_simulator(dim, len(pos), "central"), pos, vel)
+    a_laplacian = _accelerations(probe_simulator(dim, len(pos), "laplacian"), pos, vel)
     assert np.abs(a_central).max() < 1e-4 * scale
     assert np.abs(a_laplacian).max() > 0.5 * scale
 
@@ -139,7 +118,7 @@ def test_momenta_and_dissipation_of_a_random_flow(dim, name):
     pos = _disordered_ball(dim)
     rng = np.random.default_rng(7)
     vel = rng.normal(0.0, 0.1, pos.shape)
-    a = _accelerations(_simulator(dim, pos, name), pos, vel)
+    a = _accelerations(probe_simulator(dim, len(pos), name), pos, vel)
     size = np.abs(a).max()
     assert np.abs(a.sum(axis=0)).max() < 1e-4 * size * len(pos) ** 0.5
     torque = (pos[:, 0] * a[:, 1] - pos[:, 1] * a[:, 0]).sum()
@@ -227,6 +206,6 @@ def test_mode2_flow_dissipation_against_lambs(radius_l0):
     lamb = 2.0 * NU * (G * G).sum() * len(pos) * L0 ** dim        # / rho
     low = 1.0 - 1.5 / radius_l0
     for name, limit in (("laplacian", 0.5), ("central", 1.0)):
-        a = _accelerations(_simulator(dim, pos, name), pos, vel)
+        a = _accelerations(probe_simulator(dim, len(pos), name), pos, vel)
         ratio = -(vel * a).sum() * L0 ** dim / lamb
         assert low * limit < ratio < 1.05 * limit, (name, ratio)

@@ -18,10 +18,11 @@ import numpy as np
 import pytest
 
 from crowndemo.core import FLUID, Numerics, simulator_for
-from crowndemo.core.lattice import lattice_offsets, n0_lambda0, weight
+from crowndemo.core.lattice import n0_lambda0
 from crowndemo.core.params import with_values
 from crowndemo.scenes import (layer_middle, momentum_deficit, shear_amplitude, shear_wave,
                               sliding_layer)
+from viscous_probe import fourth_moments
 
 L0 = 1.0e-4
 RE_RATIO = 2.1
@@ -125,11 +126,7 @@ def test_sliding_layer_with_the_central_viscosity_on_both_floors():
     V1 term (its vn_floor table, viscosity.CentralViscosity.floor) gives the particle floor's
     deficit within 1e-3 of it."""
     l0, delta = 1.0e-4, 1.0e-3
-    q = lattice_offsets(2, 1.0, RE_RATIO)                 # the lattice's fourth moments
-    r2 = (q * q).sum(axis=1)
-    w = weight(np.sqrt(r2), RE_RATIO)
-    m4 = (w * q[:, 0] ** 4 / r2).sum()
-    m22 = (w * q[:, 0] ** 2 * q[:, 1] ** 2 / r2).sum()
+    m4, m22 = fourth_moments(2, RE_RATIO)
     ratio = m22 / ((m4 + m22) * 2 / (2 * 4))          # m22 / m22_iso, lambda0 n0 = 2 (m4 + m22)
     assert 0.8 < ratio < 0.9
     deficits = {}
