@@ -44,7 +44,10 @@ def test_dam_break_surge_front_2d():
     T_ref = np.array([t for t, _ in MARTIN_MOYCE])
     Z_ref = np.array([Z for _, Z in MARTIN_MOYCE])
     assert z[0] == pytest.approx(1.0, abs=0.5 * l0 / a)        # the column's side at T = 0
-    assert np.all(np.diff(z) >= 0) and z[-1] > 2.5
+    # the front only advances, within what particles resolve: a leading particle that leaves
+    # the connected liquid moves the measured front back by a fraction of l0 (0.08 l0 seen in
+    # one multithreaded run under the suite's load), so a step back may reach half a spacing
+    assert np.all(np.diff(z) >= -0.5 * l0 / a) and z[-1] > 2.5
     assert np.all(z < 1 + 2 * T + 0.5 * l0 / a)             # behind the inviscid Ritter front
     # Issue 2 asks for 10 % for T <= 3. The run follows Martin & Moyce's curve with their time
     # origin moved by one constant dT (observables.DAM_BREAK_MAX_SHIFT says why: the first
