@@ -6,7 +6,9 @@ the method's exact values and to the step's own kernel:
 - the sum form (method.md M2) of a linear pressure field on the perfect lattice is -grad P /
   rho exactly in the interior (the lattice's second moment, sum_j w x^2 / r^2 = n0 / d), of a
   uniform one zero, and its pair forces are equal and opposite (momentum kept) for any P;
-- its viscous terms (V1, S12) are the predictor's on a disordered ball, to float rounding.
+- its viscous terms (V1, S12) are the predictor's on a disordered ball, to float rounding;
+- the pressure's zeroth-order part is nil in the lattice's interior and the whole sum form for
+  a uniform pressure, with the push on a flat face that C4's factor balances.
 """
 import importlib.util
 import itertools
@@ -16,33 +18,18 @@ import numpy as np
 import pytest
 
 from crowndemo import backend
-from crowndemo.core import FLUID, Numerics, Physics, Simulator
-from crowndemo.core.params import with_values
+from crowndemo.core import FLUID
+from crowndemo.core.lattice import lattice_offsets, weight
 from crowndemo.scenes.base import lattice_block
 from crowndemo.scenes.drop import disordered
 from crowndemo.validate.clusters import close_pairs
+from viscous_probe import L0, RE_RATIO, RHO, probe_simulator
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _spec = importlib.util.spec_from_file_location(
     "mode_power_study", os.path.join(ROOT, "tools", "mode_power_study.py"))
 tool = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(tool)
-
-L0 = 2.0 ** -9
-RE_RATIO = 2.1
-RHO = 1000.0
-NU = 1.0e-3
-
-
-def _simulator(dim: int, count: int, viscosity: str) -> Simulator:
-    physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, rho=RHO, nu=NU, sigma=0.0,
-                      gravity=0.0, sound_speed=5.0)
-    numerics = with_values(Numerics(), viscosity=viscosity, pressure_gradient="sum",
-                           collision=0.0)
-    sim = Simulator(physics, numerics, count)
-    sim.configure(physics, numerics, (tuple([-1.0] * dim), tuple([1.0] * dim)))
-    return sim
-
 
 def _ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
     """The cases' drop start (scenes/drop.oscillating_drop's): a lattice ball, disordered."""
@@ -65,7 +52,7 @@ def test_pairs_are_every_pair_within_re_once():
 
 @pytest.mark.parametrize("dim", [2, 3])
 def test_sum_form_of_a_linear_pressure_is_its_gradient(dim):
-    sim = _simulator(dim, 8, "central")
+    sim = probe_simulator(dim, 8, "central")
     m = 6 if dim == 2 else 4
     x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
     interior = np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
@@ -83,11 +70,41 @@ def test_sum_form_of_a_linear_pressure_is_its_gradient(dim):
 
 
 @pytest.mark.parametrize("dim", [2, 3])
+def test_zeroth_order_part_of_the_sum_form(dim):
+    """The pressure's zeroth-order part, 2 P_i sum_j g_ij: nil in the lattice's interior for
+    any P (sum_j g_ij = 0 by the lattice's symmetry); the whole sum form for a uniform P (then
+    P_j - P_i = 0), at the block's faces too; on a face particle d 2 P G / (n0 rho) outward,
+    G = the half-lattice's sum of g's normal part, the push C4 balances (its factor
+    n0 / (2 d G l0) = 1.016 in 2D, 1.011 in 3D: surface_tension/stress.py)."""
+    sim = probe_simulator(dim, 8, "central")
+    m = 6 if dim == 2 else 4
+    x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
+    interior = np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
+    zero = np.zeros_like(x)
+    p = np.random.default_rng(5).uniform(0.0, 100.0, len(x))
+    part = tool.forces(sim, x, zero, p, "central")["zeroth"]
+    np.testing.assert_allclose(part[interior], 0.0, atol=1e-9 * np.abs(part).max())
+    uniform = tool.forces(sim, x, zero, np.full(len(x), 50.0), "central")
+    np.testing.assert_allclose(uniform["zeroth"], uniform["pressure"],
+                               atol=1e-12 * np.abs(uniform["pressure"]).max())
+    # the middle of the top face: its push along the last axis, outward
+    face = np.all(np.abs(x[:, :-1]) < 0.5 * L0, axis=1) & (x[:, -1] > (m - 0.5) * L0)
+    q = lattice_offsets(dim, 1.0, RE_RATIO)       # in l0
+    w = weight(np.linalg.norm(q, axis=1), RE_RATIO)
+    below = q[:, -1] < 0
+    G = -float((q[below, -1] * w[below] / (q[below] ** 2).sum(axis=1)).sum())
+    n0 = float(w.sum())
+    assert n0 / (2 * dim * G) == pytest.approx({2: 1.016, 3: 1.011}[dim], abs=1e-3)
+    expected = dim * 2.0 * 50.0 * G / (n0 * RHO * L0)
+    assert uniform["zeroth"][face][0, -1] == pytest.approx(expected, rel=1e-9)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("viscosity", ["central", "laplacian"])
 def test_viscous_terms_are_the_predictors(dim, viscosity):
     x = _ball(dim, 4.0, 0.15)
     v = np.random.default_rng(3).normal(0.0, 0.1, x.shape)
-    sim = _simulator(dim, len(x), viscosity)
+    sim = probe_simulator(dim, len(x), viscosity)
     sim.load(x, v, np.full(len(x), FLUID, dtype=np.int32))
     sim.grid.build(RE_RATIO * L0)            # no re-sort: field index i = i-th particle
     sim.predictor.forces()

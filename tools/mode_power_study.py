@@ -3,21 +3,28 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
 
     .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
                           [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
-                          [--re-ratio X] [--threads N]
+                          [--sigma-factor S] [--re-ratio X] [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
 numerics with V1, nu = 1e-5 unless --nu), run P mode-2 periods (default 5). With --kick K the
 mode's start velocity (scenes/drop.oscillating_drop's, amplitude 0.1) is added once more at
 K periods, to the drop as it then is: a second start on a liquid that has oscillated and
 settled, without the first start's melt. --sound-factor S: the drop's sound speed times S;
---re-ratio X: re = X l0 (the case's 2.1). F frames a period (default 40); at each:
+--sigma-factor S: sigma times S (water's 0.0728 N/m; the frequency follows sqrt(S), the sound
+speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: re = X l0
+(the case's 2.1). F frames a period (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
   (exactly, for a linear mode); E_m, its kinetic energy;
+- the rest's kinetic energy: of the velocities less their mean and the fitted G d (what no
+  linear field carries: the particles' own motion, and any other mode's);
 - each force's power on that flow, m sum_i a_i . u_m(x_i): the pressure gradient (the sum
   form, method.md M2, of the frame's EOS pressure, S21), the viscous term (V1 or S12, method.md
   §3b, of the frame's velocities), the surface stress (the member's a_i of the last step);
+  the pressure's zeroth-order part, the sum form's -(d / (n0 rho)) 2 P_i sum_j r_ij w / r^2
+  (nil for a uniform P on the lattice's interior; at the free surface the push that C4's
+  pressure balances the stress's pull with), a part of the pressure's, not added to the sum;
   and each split by layer: the free surface (n < beta n0), and the fluid under it at depth
   < 1.5 l0, 1.5-2.5 l0 and deeper (the distance to the nearest free-surface particle).
 
@@ -52,8 +59,9 @@ def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float
 
 def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
            viscosity: str) -> Dict[str, np.ndarray]:
-    """The pressure gradient (sum form, M2) and the viscous term (the member ``viscosity``:
-    V1 or S12) [m/s^2], numpy over the pairs within re (validate/clusters.close_pairs)."""
+    """The pressure gradient (sum form, M2), its zeroth-order part (``zeroth``) and the viscous
+    term (the member ``viscosity``: V1 or S12) [m/s^2], numpy over the pairs within re
+    (validate/clusters.close_pairs)."""
     from crowndemo.core.lattice import weight
     from crowndemo.core.viscosity import member
     from crowndemo.validate.clusters import close_pairs
@@ -65,13 +73,16 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
     n = len(x)
     # M2: a_i = -d / (n0 rho) sum_j (P_i + P_j) r_ij w / r^2, r_ij = x_j - x_i (antisymmetric)
     acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, ((p[i] + p[j]) * w / r2)[:, None] * rij, -1)
+    # its split: (P_j - P_i) r_ij w / r^2 (the gradient, S11) + 2 P_i r_ij w / r^2 (this part)
+    acc_zero = -dim / (n0 * rho) * 2.0 * p[:, None] * pair_sum(n, i, j,
+                                                                (w / r2)[:, None] * rij, -1)
     du = v[j] - v[i]
     if viscosity == "central":      # V1's pair term: ((du . r) r / r^2) w
         f = ((du * rij).sum(axis=1) * w / r2)[:, None] * rij
     else:                           # S12's: (u_j - u_i) w
         f = du * w[:, None]
     acc_v = ph.nu * member(viscosity).factor(dim) / (lat.lambda0 * n0) * pair_sum(n, i, j, f, -1)
-    return {"pressure": acc_p, "viscosity": acc_v}
+    return {"pressure": acc_p, "viscosity": acc_v, "zeroth": acc_zero}
 
 
 def main() -> None:
@@ -84,6 +95,7 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=40, metavar="F")
     ap.add_argument("--numerics", action="append", default=[], metavar="KEY=VALUE")
     ap.add_argument("--sound-factor", type=float, default=1.0)
+    ap.add_argument("--sigma-factor", type=float, default=1.0)
     ap.add_argument("--re-ratio", type=float, default=None, help="re / l0 (default: the case's)")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
@@ -104,9 +116,11 @@ def main() -> None:
     numerics = numerics.validate("--numerics")
     l0 = tc.R / a.scale
     nu = tc.OSCILLATION_NU if a.nu is None else a.nu
-    c = drop_sound_speed(l0, WATER["sigma"], WATER["rho"]) * a.sound_factor
+    sigma = WATER["sigma"] * a.sigma_factor
+    c = drop_sound_speed(l0, sigma, WATER["rho"]) * a.sound_factor
     scene = oscillating_drop(dim=a.dim, radius=tc.R, l0=l0, nu=nu, periods=a.periods,
-                             numerics=numerics, disorder=tc.DISORDER[a.dim], sound_speed=c)
+                             numerics=numerics, disorder=tc.DISORDER[a.dim], sound_speed=c,
+                             sigma=sigma)
     if a.re_ratio is not None:
         scene = replace(scene, physics=replace(scene.physics, re_ratio=a.re_ratio).validate())
     period, lamb = scene.info["period_s"], scene.info["decay_1_s"]
@@ -149,7 +163,9 @@ def main() -> None:
         masks = (surface, ~surface & (depth < 1.5 * l0),
                  ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0),
                  ~surface & (depth >= 2.5 * l0))
+        rest = u - d @ G.T              # what no linear field carries: the particles' own
         row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum()),
+               "E_rest": 0.5 * mass * float((rest * rest).sum()),
                "deformation": oscillation.deformation(x)}
         for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
@@ -162,13 +178,16 @@ def main() -> None:
     sim.run(scene.t_end, frame_times=frames, on_frame=on_frame)
     t = np.array([r["t"] for r in rows])
     E = np.array([r["E_m"] for r in rows])
-    names = ("pressure", "viscosity", "stress")
+    names = ("pressure", "viscosity", "stress")      # the sum's terms
+    shown = names + ("zeroth",)                       # and the pressure's zeroth-order part
     print(f"{a.dim}D drop, R/l0 = {a.scale:g}, {int(scene.kind.size)} particles, nu = {nu:g}, "
-          f"c = {c:.3g} m/s, {numerics.viscosity} viscosity; T = {period * 1e3:.3f} ms, "
+          f"sigma = {sigma:g} N/m, c = {c:.3g} m/s, {numerics.viscosity} viscosity; "
+          f"omega = {scene.info['omega_rad_s']:.1f} rad/s, T = {period * 1e3:.3f} ms, "
           f"Lamb's decay {lamb:.1f} 1/s (a loss of {4 * lamb * period:.2f} mean E_m a period)"
           + (f"; kicked at {a.kick:g} T" if a.kick > 0 else ""))
     print("period | work on the mode's flow / the period's mean E_m: pressure, viscosity, stress, "
-          "sum | by layer (" + ", ".join(layers) + "): pressure; stress")
+          "sum | by layer (" + ", ".join(layers) + "): pressure; stress | the pressure's "
+          "zeroth-order part, by layer | the rest's mean kinetic energy / E_m's")
     peaks, after = [], []
     # read from the kick on, else where the case's fit starts (after a disordered start's melt)
     first = int(round(a.kick)) if a.kick > 0 else (1 if tc.DISORDER[a.dim] > 0 else 0)
@@ -176,19 +195,24 @@ def main() -> None:
         m = (t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)
         mean_E = E[m].mean()
         work = {q: np.trapezoid([r[q] for r, keep in zip(rows, m) if keep], t[m]) / mean_E
-                for q in list(names) + [(q, layer) for q in names for layer in layers]}
+                for q in list(shown) + [(q, layer) for q in shown for layer in layers]}
         peaks.append(E[m].max())
+        work["rest"] = float(np.mean([r["E_rest"] for r, keep in zip(rows, m) if keep])) / mean_E
         if k >= first:
             after.append(work)
         cut = " (ends at the kick: not read)" if a.kick > 0 and k == first - 1 else ""
         print(f"{k} | {work['pressure']:+.2f} {work['viscosity']:+.2f} {work['stress']:+.2f} "
               f"{sum(work[q] for q in names):+.2f} | "
               + " ".join(f"{work[('pressure', layer)]:+.2f}" for layer in layers) + "; "
-              + " ".join(f"{work[('stress', layer)]:+.2f}" for layer in layers) + cut)
+              + " ".join(f"{work[('stress', layer)]:+.2f}" for layer in layers) + " | "
+              + f"{work['zeroth']:+.2f} ("
+              + " ".join(f"{work[('zeroth', layer)]:+.2f}" for layer in layers) + ") | "
+              + f"{work['rest']:.2f}" + cut)
     mean = {q: float(np.mean([w[q] for w in after])) for q in after[0]}
     print(f"mean over the periods from {first}: " + ", ".join(
         f"{q} {mean[q]:+.2f} (" + " ".join(f"{mean[(q, layer)]:+.2f}" for layer in layers) + ")"
-        for q in names) + f"; sum {sum(mean[q] for q in names):+.2f}")
+        for q in shown) + f"; sum (of the first three) {sum(mean[q] for q in names):+.2f}; "
+          f"the rest's kinetic energy {mean['rest']:.2f} E_m")
     gammas = [-math.log(peaks[k + 1] / peaks[k]) / (2 * period)
               for k in range(first, len(peaks) - 1)]
     print("decay from E_m's peaks, period by period from " + str(first) + ": "
