@@ -163,7 +163,7 @@ def main() -> None:
         masks = (surface, ~surface & (depth < 1.5 * l0),
                  ~surface & (depth >= 1.5 * l0) & (depth < 2.5 * l0),
                  ~surface & (depth >= 2.5 * l0))
-        rest = u - d @ G.T              # what no linear field carries: the particles' own
+        rest = u - d @ G.T              # what no linear field carries: the particles' own motion
         row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum()),
                "E_rest": 0.5 * mass * float((rest * rest).sum()),
                "deformation": oscillation.deformation(x)}
