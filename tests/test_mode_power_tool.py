@@ -31,6 +31,7 @@ _spec = importlib.util.spec_from_file_location(
 tool = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(tool)
 
+
 def _ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
     """The cases' drop start (scenes/drop.oscillating_drop's): a lattice ball, disordered."""
     r = radius_l0 * L0
@@ -50,12 +51,18 @@ def test_pairs_are_every_pair_within_re_once():
     np.testing.assert_allclose(np.sqrt(d2), d[i, j])
 
 
+def _block(dim: int):
+    """A perfect lattice block of half-width m spacings, and its interior (the points whose
+    neighbourhood within re lies inside the block)."""
+    m = 6 if dim == 2 else 4
+    x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
+    return m, x, np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
+
+
 @pytest.mark.parametrize("dim", [2, 3])
 def test_sum_form_of_a_linear_pressure_is_its_gradient(dim):
     sim = probe_simulator(dim, 8, "central")
-    m = 6 if dim == 2 else 4
-    x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
-    interior = np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
+    m, x, interior = _block(dim)
     k = np.arange(1.0, dim + 1.0) * 1.0e5                       # grad P [Pa/m]
     zero = np.zeros_like(x)
     acc = tool.forces(sim, x, zero, 50.0 + x @ k, "central")["pressure"]
@@ -64,9 +71,8 @@ def test_sum_form_of_a_linear_pressure_is_its_gradient(dim):
     uniform = tool.forces(sim, x, zero, np.full(len(x), 50.0), "central")["pressure"]
     np.testing.assert_allclose(uniform[interior], 0.0, atol=1e-9 * np.abs(k / RHO).max())
     p = np.random.default_rng(2).uniform(0.0, 100.0, len(x))
-    total = tool.forces(sim, x, zero, p, "central")["pressure"].sum(axis=0)
-    scale = np.abs(tool.forces(sim, x, zero, p, "central")["pressure"]).max()
-    np.testing.assert_allclose(total, 0.0, atol=1e-12 * scale * len(x))
+    acc = tool.forces(sim, x, zero, p, "central")["pressure"]
+    np.testing.assert_allclose(acc.sum(axis=0), 0.0, atol=1e-12 * np.abs(acc).max() * len(x))
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -77,9 +83,7 @@ def test_zeroth_order_part_of_the_sum_form(dim):
     G = the half-lattice's sum of g's normal part, the push C4 balances (its factor
     n0 / (2 d G l0) = 1.016 in 2D, 1.011 in 3D: surface_tension/stress.py)."""
     sim = probe_simulator(dim, 8, "central")
-    m = 6 if dim == 2 else 4
-    x = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float) * L0
-    interior = np.max(np.abs(x), axis=1) <= (m - RE_RATIO) * L0 + 1e-12
+    m, x, interior = _block(dim)
     zero = np.zeros_like(x)
     p = np.random.default_rng(5).uniform(0.0, 100.0, len(x))
     part = tool.forces(sim, x, zero, p, "central")["zeroth"]
