@@ -147,6 +147,49 @@ def test_ctrl_c_then_resume_is_bit_identical(uninterrupted, preset, tmp_path):
             assert np.array_equal(a[k], b[k]), (f["file"], k)
 
 
+def _without(fp: dict, paths) -> dict:
+    out = json.loads(json.dumps(fp))
+    for path in paths:
+        d = out
+        for k in path[:-1]:
+            d = d[k]
+        del d[path[-1]]
+    return out
+
+
+def test_resume_of_a_checkpoint_made_before_a_key_existed(uninterrupted, preset, tmp_path):
+    """A checkpoint whose fingerprint lacks the keys added since (ADDED_KEYS) continues where
+    the preset holds the values that ran before them, and ends as the uninterrupted run; one
+    whose preset now departs from such a value is refused, naming the key."""
+    from crowndemo.record import RecordError
+    from crowndemo.record.recorder import ADDED_KEYS, SAME, fingerprint
+    folder = tmp_path / "quick-2d"
+    assert record_preset(preset, folder, session=Session(), max_steps=50).status == "interrupted"
+    path = folder / files.CHECKPOINT
+    ck = load_checkpoint(path)
+    now = fingerprint(preset, "f32")
+
+    def value(p):
+        d = now
+        for k in p:
+            d = d[k]
+        return d
+    same = [p for p, before in ADDED_KEYS.items() if before is SAME or before == value(p)]
+    assert {p[-1] for p in same} >= {"surface_tension", "viscosity", "predictor_list",
+                                     "wall_model", "mirror_planes", "symmetry"}
+    save_checkpoint(path, ck.saved, ck.log, ck.next_frame, _without(ck.fingerprint, same))
+    resumed = record_preset(preset, folder, resume=True, session=Session())
+    assert resumed.complete
+    same_state(uninterrupted[1], resumed.sim.save_state())
+    # quick-2d collides particles at 0.5 l0; before numerics.collision there were no collisions
+    assert value(("crown", "numerics", "collision")) == 0.5
+    save_checkpoint(path, ck.saved, ck.log, ck.next_frame,
+                    _without(ck.fingerprint, [("crown", "numerics", "collision")]))
+    os.remove(folder / files.METADATA)     # the complete recording's: the checkpoint decides
+    with pytest.raises(RecordError, match=r"numerics\.collision: 0\.0 -> 0\.5"):
+        record_preset(preset, folder, resume=True, session=Session())
+
+
 def test_checkpoint_keeps_every_run_statistic(uninterrupted, tmp_path):
     state = uninterrupted[1]
     assert state["stats"].peak_max_density_excess > state["stats"].health.max_density_excess

@@ -93,7 +93,9 @@ def _export(args) -> int:
         meta = _read_meta(folder / METADATA)
     elif args.quality is not None or args.sets:
         from ..record.checkpoint import differences
-        diff = differences(meta.get("fingerprint") or {}, fingerprint(r, args.precision))
+        from ..record.recorder import with_added_keys
+        now = fingerprint(r, args.precision)
+        diff = differences(with_added_keys(meta.get("fingerprint") or {}, now), now)
         if diff:
             raise UsageError(f"{folder} was recorded with other values ({'; '.join(diff[:3])})"
                              f"; record it again or leave out --quality/--set")

@@ -74,9 +74,48 @@ def fingerprint(resolved: Resolved, precision: str) -> dict:
     return json.loads(json.dumps(finite_or_none(data)))
 
 
+# Fingerprint keys added after the checkpoint format (FORMAT 1, dd88632), each with the value
+# that ran before it existed, by the commit that added it: a checkpoint or recording that
+# lacks a key was made with that value. SAME: an implementation choice whose results equal
+# the other's to float rounding (core/params.py), so any value now continues it.
+SAME = object()
+ADDED_KEYS = {
+    ("crown", "numerics", "collision"): 0.0,              # a937380: no collisions before it
+    ("crown", "numerics", "restitution"): 0.2,            # a937380 (read with collisions only)
+    ("crown", "numerics", "neighbour_list"): SAME,        # ba6a28f
+    ("crown", "numerics", "cells_per_re"): SAME,          # af08c90
+    ("crown", "numerics", "wall_model"): "particles",     # 6c534cf
+    ("crown", "numerics", "courant_speed"): "absolute",   # 1843f81
+    ("crown", "numerics", "approach"): 0.5,               # 1843f81 (read with "relative" only)
+    ("crown", "numerics", "mirror_planes"): [],           # 6889de4
+    ("crown", "numerics", "predictor_list"): SAME,        # 61e0a5a
+    ("crown", "numerics", "surface_tension"): "potential",  # fa57f31
+    ("crown", "numerics", "viscosity"): "laplacian",      # f50bdf2
+    ("crown", "symmetry"): "full",                        # e651047
+    ("crown", "trim_reach"): 2.0,                         # e651047 (crown.TRIM_REACH)
+}
+
+
+def with_added_keys(saved: dict, now: dict) -> dict:
+    """``saved`` (a fingerprint) with each ADDED_KEYS key it lacks set to the value that ran
+    before the key existed (now's value for a SAME key); the keys it has are left as they are."""
+    out = json.loads(json.dumps(saved))
+    for path, before in ADDED_KEYS.items():
+        into, there = out, now
+        for k in path[:-1]:
+            into, there = into.get(k), (there or {}).get(k)
+            if not isinstance(into, dict):
+                break
+        else:
+            if path[-1] not in into:
+                into[path[-1]] = (there or {}).get(path[-1]) if before is SAME else before
+    return out
+
+
 def _other_parameters(path: Path, saved: dict, now: dict) -> None:
-    """RecordError naming the keys whose values differ, if any."""
-    diff = ckpt.differences(saved, now)
+    """RecordError naming the keys whose values differ, if any (a key that came after the
+    file counts as the value that ran before it: ADDED_KEYS)."""
+    diff = ckpt.differences(with_added_keys(saved, now), now)
     if diff:
         raise RecordError(f"{path} was made with other parameters ("
                           f"{'; '.join(diff[:4])}{'; ...' if len(diff) > 4 else ''}); "
