@@ -20,23 +20,14 @@ import pytest
 from crowndemo import backend
 from crowndemo.core import FLUID
 from crowndemo.core.lattice import lattice_offsets, weight
-from crowndemo.scenes.base import lattice_block
-from crowndemo.scenes.drop import disordered
 from crowndemo.validate.clusters import close_pairs
-from viscous_probe import L0, RE_RATIO, RHO, probe_simulator
+from viscous_probe import L0, RE_RATIO, RHO, disordered_ball, probe_simulator
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 _spec = importlib.util.spec_from_file_location(
     "mode_power_study", os.path.join(ROOT, "tools", "mode_power_study.py"))
 tool = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(tool)
-
-
-def _ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
-    """The cases' drop start (scenes/drop.oscillating_drop's): a lattice ball, disordered."""
-    r = radius_l0 * L0
-    pts = lattice_block([-r] * dim, [r] * dim, L0)
-    return disordered(pts[np.linalg.norm(pts, axis=1) <= r], L0, jitter)
 
 
 def test_pairs_are_every_pair_within_re_once():
@@ -106,7 +97,7 @@ def test_zeroth_order_part_of_the_sum_form(dim):
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("viscosity", ["central", "laplacian"])
 def test_viscous_terms_are_the_predictors(dim, viscosity):
-    x = _ball(dim, 4.0, 0.15)
+    x = disordered_ball(dim, 4.0, 0.15)
     v = np.random.default_rng(3).normal(0.0, 0.1, x.shape)
     sim = probe_simulator(dim, len(x), viscosity)
     sim.load(x, v, np.full(len(x), FLUID, dtype=np.int32))

@@ -27,7 +27,7 @@ from crowndemo.core.params import (VISCOUS_STIFFNESS, Model, ParameterError,
                                    with_values)
 from crowndemo.core.plane_floor import FLOOR_V, FLOOR_VN, floor_tables
 from crowndemo.core.timestep import limits
-from viscous_probe import L0, NU, RE_RATIO, fourth_moments, probe_simulator
+from viscous_probe import L0, NU, RE_RATIO, disordered_ball, fourth_moments, probe_simulator
 
 HALF = {2: 7, 3: 5}
 
@@ -78,16 +78,6 @@ def test_quadratic_fields_on_the_lattice(dim, profile):
         assert np.abs(a[:, 1:]).max() <= tol, name
 
 
-def _disordered_ball(dim: int, radius_l0: float = 5.0, seed: int = 3,
-                     jitter: float = 0.2) -> np.ndarray:
-    """The lattice points within radius_l0 l0, each moved by up to jitter l0 along each axis."""
-    rng = np.random.default_rng(seed)
-    m = int(radius_l0) + 1
-    ks = np.array(list(itertools.product(range(-m, m + 1), repeat=dim)), dtype=float)
-    ks = ks[np.linalg.norm(ks, axis=1) <= radius_l0]
-    return (ks + rng.uniform(-jitter, jitter, ks.shape)) * L0
-
-
 def _rotation(dim: int, pos: np.ndarray, omega: float) -> np.ndarray:
     vel = np.zeros_like(pos)                     # u = omega e_z x r: in the (x, y) plane
     vel[:, 0], vel[:, 1] = -omega * pos[:, 1], omega * pos[:, 0]
@@ -99,7 +89,7 @@ def test_a_rigid_motion_feels_no_central_viscosity(dim):
     """A disordered ball translating and turning as a solid: the central form gives no
     acceleration anywhere (float rounding); the Laplacian does at the surface, where the
     particles lack neighbours on one side (sum_j (u_j - u_i) w = omega e_z x sum_j r_ij w)."""
-    pos = _disordered_ball(dim)
+    pos = disordered_ball(dim, 5.0, 0.2)
     omega = 100.0                                  # rad/s: surface speed 0.1 m/s at 1 mm
     vel = _rotation(dim, pos, omega) + 0.05
     scale = NU * omega / L0                        # the Laplacian's size at the surface
@@ -115,7 +105,7 @@ def test_momenta_and_dissipation_of_a_random_flow(dim, name):
     """Random velocities on a disordered ball: both keep the momentum (pair terms equal and
     opposite) and dissipate (- sum u . a > 0); the central form keeps the angular momentum
     too, the Laplacian does not."""
-    pos = _disordered_ball(dim)
+    pos = disordered_ball(dim, 5.0, 0.2)
     rng = np.random.default_rng(7)
     vel = rng.normal(0.0, 0.1, pos.shape)
     a = _accelerations(probe_simulator(dim, len(pos), name), pos, vel)
@@ -199,7 +189,7 @@ def test_mode2_flow_dissipation_against_lambs(radius_l0):
     and above, 1 + 0.05 for the central form on the lattice's fourth moment (m4 / 3 m22 =
     1.11; up to +3 % measured on the lattice cut)."""
     dim = 3
-    pos = _disordered_ball(dim, radius_l0, seed=0, jitter=0.15)
+    pos = disordered_ball(dim, radius_l0, 0.15)
     gamma = 10.0                                          # 1/s
     G = gamma * np.diag([-1.0, -1.0, 2.0])
     vel = pos @ G.T

@@ -1,12 +1,14 @@
 """Shared by the viscosity tests (test_viscosity, test_viscous_flow, test_mode_power_tool): the
-lattice's fourth moments, which the central viscosity's sums on the lattice are exact in, and a
-Simulator of fluid particles without surface tension or gravity, whose forces a test probes
-one call at a time."""
+lattice's fourth moments, which the central viscosity's sums on the lattice are exact in, the
+drop cases' disordered ball, and a Simulator of fluid particles without surface tension or
+gravity, whose forces a test probes one call at a time."""
 import numpy as np
 
 from crowndemo.core import Numerics, Physics, Simulator
 from crowndemo.core.lattice import lattice_offsets, weight
 from crowndemo.core.params import with_values
+from crowndemo.scenes.base import lattice_block
+from crowndemo.scenes.drop import disordered
 
 L0 = 2.0 ** -9          # a power of two: lattice positions are exact in float
 RE_RATIO = 2.1
@@ -21,6 +23,15 @@ def fourth_moments(dim: int, re_ratio: float = RE_RATIO) -> tuple:
     w = weight(np.sqrt(r2), re_ratio)
     return (float((w * q[:, 0] ** 4 / r2).sum()),
             float((w * q[:, 0] ** 2 * q[:, -1] ** 2 / r2).sum()))
+
+
+def disordered_ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
+    """The drop cases' start (scenes/drop.oscillating_drop's): the lattice points within
+    radius_l0 L0 of the centre, each moved by up to jitter L0 along each axis (scenes'
+    seeded disorder)."""
+    r = radius_l0 * L0
+    pts = lattice_block([-r] * dim, [r] * dim, L0)
+    return disordered(pts[np.linalg.norm(pts, axis=1) <= r], L0, jitter)
 
 
 def probe_simulator(dim: int, count: int, viscosity: str) -> Simulator:
