@@ -154,6 +154,12 @@ def main() -> None:
         acc = forces(s, x, v, p, numerics.viscosity)
         order = np.argsort(s.state.pid.to_numpy()[:s.state.count], kind="stable")
         acc["stress"] = s.surface_tension.accel.to_numpy()[:s.state.count][order][fluid]
+        # the surface's pull (stress) and push (zeroth) along the colour gradient's direction
+        g = s.surface_tension.colour.to_numpy()[:s.state.count][order][fluid].astype(float)
+        gl = np.linalg.norm(g, axis=1)
+        n_hat = np.where(gl[:, None] > 0, g / np.maximum(gl, 1e-300)[:, None], 0.0)
+        for q in ("stress", "zeroth"):
+            acc[q + " normal"] = (acc[q] * n_hat).sum(axis=1)[:, None] * n_hat
         surface = snap["number_density"][fluid] < beta * s.lattice.n0   # M3, the step's n
         depth = np.full(len(x), np.inf)
         if surface.any():
@@ -195,7 +201,8 @@ def main() -> None:
         m = (t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)
         mean_E = E[m].mean()
         work = {q: np.trapezoid([r[q] for r, keep in zip(rows, m) if keep], t[m]) / mean_E
-                for q in list(shown) + [(q, layer) for q in shown for layer in layers]}
+                for q in list(shown) + ["stress normal", "zeroth normal"]
+                + [(q, layer) for q in shown for layer in layers]}
         peaks.append(E[m].max())
         work["rest"] = float(np.mean([r["E_rest"] for r, keep in zip(rows, m) if keep])) / mean_E
         if k >= first:
@@ -213,6 +220,9 @@ def main() -> None:
         f"{q} {mean[q]:+.2f} (" + " ".join(f"{mean[(q, layer)]:+.2f}" for layer in layers) + ")"
         for q in shown) + f"; sum (of the first three) {sum(mean[q] for q in names):+.2f}; "
           f"the rest's kinetic energy {mean['rest']:.2f} E_m")
+    print("along the colour gradient / across it (the rest): " + ", ".join(
+        f"{q} {mean[q + ' normal']:+.2f} / {mean[q] - mean[q + ' normal']:+.2f}"
+        for q in ("stress", "zeroth")))
     gammas = [-math.log(peaks[k + 1] / peaks[k]) / (2 * period)
               for k in range(first, len(peaks) - 1)]
     print("decay from E_m's peaks, period by period from " + str(first) + ": "
