@@ -26,7 +26,11 @@ speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: 
   (nil for a uniform P on the lattice's interior; at the free surface the push that C4's
   pressure balances the stress's pull with), a part of the pressure's, not added to the sum;
   and each split by layer: the free surface (n < beta n0), and the fluid under it at depth
-  < 1.5 l0, 1.5-2.5 l0 and deeper (the distance to the nearest free-surface particle).
+  < 1.5 l0, 1.5-2.5 l0 and deeper (the distance to the nearest free-surface particle); the
+  stress's and the zeroth-order part's power also split along the colour gradient g_i (C1)
+  and across it (a particle without g: all across);
+- each force's power on every particle's motion (the velocities less their mean), and the
+  kinetic energy.
 
 Per period: each force's work on the mode's flow over the period, over the period's mean
 E_m (a loss at Lamb's rate gamma is -4 gamma T of it; the period that ends at the kick has
@@ -34,7 +38,10 @@ it in its last frame and is not read). Over the periods read (from the kick on; 
 one, from where the case's fit starts: the second period in 3D, the first in 2D): each
 force's mean work, layer by layer; the decay from the peaks of E_m, one a half period,
 gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T); and the deformation's fit (the case's,
-validate/oscillation.py). numpy over the pairs within re (a few thousand particles: seconds
+validate/oscillation.py). From each peak of E_m to the next: the kinetic energy's change
+beside each force's work on every particle's motion (in the continuum the pressure's and the
+stress's would be nil, the drop round at both ends; VALIDATION.md "The surface's push and
+pull along its normal"). numpy over the pairs within re (a few thousand particles: seconds
 a frame); the pressure and the stress are those of the frame's positions and the last
 step's r*, so the split is a diagnostic, not the step's own bookkeeping.
 """
@@ -173,9 +180,11 @@ def main() -> None:
         row = {"t": s.stats.time, "E_m": 0.5 * mass * float((um * um).sum()),
                "E_rest": 0.5 * mass * float((rest * rest).sum()),
                "deformation": oscillation.deformation(x)}
+        row["E_kin"] = 0.5 * mass * float((u * u).sum())
         for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
             row[name] = float(power.sum())
+            row[(name, "all")] = mass * float((a_i * u).sum())   # on every particle's motion
             for layer, m in zip(layers, masks):
                 row[(name, layer)] = float(power[m].sum())
         rows.append(row)
@@ -223,6 +232,21 @@ def main() -> None:
     print("along the colour gradient / across it (the rest): " + ", ".join(
         f"{q} {mean[q + ' normal']:+.2f} / {mean[q] - mean[q + ' normal']:+.2f}"
         for q in ("stress", "zeroth")))
+    # from one peak of E_m to the next (the drop round, its surface energy at its least):
+    # the kinetic energy's change and each force's work on every particle's motion
+    tops = [int(np.flatnonzero((t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12))[
+        np.argmax(E[(t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)])])
+        for k in range(first, int(round(a.periods)))]
+    for k0, k1 in zip(tops, tops[1:]):
+        seg = slice(k0, k1 + 1)
+        mean_E = E[seg].mean()
+        w = {q: np.trapezoid([r[(q, "all")] for r in rows[seg]], t[seg]) / mean_E for q in names}
+        dK = (rows[k1]["E_kin"] - rows[k0]["E_kin"]) / mean_E
+        print(f"E_m's peaks at {t[k0] / period:.2f} -> {t[k1] / period:.2f} T: the kinetic "
+              f"energy's change {dK:+.2f}; the work on every particle's motion: "
+              + ", ".join(f"{q} {w[q]:+.2f}" for q in names)
+              + f" (sum {sum(w.values()):+.2f}; mean E_m's, E_m = {mean_E:.3g} J; the "
+              f"pressure's and stress's work on it {(w['pressure'] + w['stress']) * mean_E:.3g} J)")
     gammas = [-math.log(peaks[k + 1] / peaks[k]) / (2 * period)
               for k in range(first, len(peaks) - 1)]
     print("decay from E_m's peaks, period by period from " + str(first) + ": "
