@@ -38,7 +38,6 @@ def main() -> None:
     from crowndemo import backend
     backend.init("cpu", threads=a.threads)
     from crowndemo.core import Numerics, Physics
-    from crowndemo.core.state import FLUID
     from crowndemo.scenes.base import assemble, lattice_block
     from crowndemo.scenes.drop import disordered
     from crowndemo.validate.cases import simulator
@@ -64,15 +63,7 @@ def main() -> None:
     rows = []
 
     def on_frame(s, index: int) -> None:
-        s.refresh_pressure()
-        snap = s.snapshot()
-        fluid = snap["kind"] == FLUID
-        x, v, p = (snap[k][fluid].astype(float) for k in ("pos", "vel", "pressure"))
-        d, u = x - x.mean(axis=0), v - v.mean(axis=0)
-        G = np.linalg.lstsq(d, u, rcond=None)[0].T
-        Gs = 0.5 * (G + G.T)
-        Gs -= np.trace(Gs) / 3.0 * np.eye(3)
-        um = d @ Gs.T
+        _, _, x, v, p, d, u, G, um = tool.linear_flow(s)
         acc = tool.forces(s, x, v, p, "central")
         rows.append([s.stats.time, 0.5 * mass * (um * um).sum(),
                      0.5 * mass * ((u - d @ G.T) ** 2).sum()]

@@ -92,6 +92,22 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
     return {"pressure": acc_p, "viscosity": acc_v, "zeroth": acc_zero}
 
 
+def linear_flow(sim) -> tuple:
+    """The frame's fluid (pressures refreshed) and its velocities about their mean fitted by a
+    linear field v = G d: (snapshot, fluid mask, x, v, P, d = x - mean, u = v - mean, G, u_m),
+    u_m = d G_s^T with G_s G's symmetric traceless part (mode 2's flow)."""
+    from crowndemo.core.state import FLUID
+    sim.refresh_pressure()
+    snap = sim.snapshot()
+    fluid = snap["kind"] == FLUID
+    x, v, p = (snap[k][fluid].astype(float) for k in ("pos", "vel", "pressure"))
+    d, u = x - x.mean(axis=0), v - v.mean(axis=0)
+    G = np.linalg.lstsq(d, u, rcond=None)[0].T
+    Gs = 0.5 * (G + G.T)
+    Gs -= np.trace(Gs) / len(Gs) * np.eye(len(Gs))
+    return snap, fluid, x, v, p, d, u, G, d @ Gs.T
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("dim", type=int, choices=(2, 3))
@@ -149,15 +165,7 @@ def main() -> None:
             d = pos[:count][fluid] - pos[:count][fluid].mean(axis=0)
             vel[:count][fluid] += (d @ G0.T).astype(vel.dtype)
             st.vel.from_numpy(vel)
-        s.refresh_pressure()
-        snap = s.snapshot()
-        fluid = snap["kind"] == FLUID
-        x, v, p = (snap[k][fluid].astype(float) for k in ("pos", "vel", "pressure"))
-        d, u = x - x.mean(axis=0), v - v.mean(axis=0)
-        G = np.linalg.lstsq(d, u, rcond=None)[0].T
-        Gs = 0.5 * (G + G.T)
-        Gs -= np.trace(Gs) / a.dim * np.eye(a.dim)
-        um = d @ Gs.T
+        snap, fluid, x, v, p, d, u, G, um = linear_flow(s)
         acc = forces(s, x, v, p, numerics.viscosity)
         order = np.argsort(s.state.pid.to_numpy()[:s.state.count], kind="stable")
         acc["stress"] = s.surface_tension.accel.to_numpy()[:s.state.count][order][fluid]
@@ -203,7 +211,7 @@ def main() -> None:
     print("period | work on the mode's flow / the period's mean E_m: pressure, viscosity, stress, "
           "sum | by layer (" + ", ".join(layers) + "): pressure; stress | the pressure's "
           "zeroth-order part, by layer | the rest's mean kinetic energy / E_m's")
-    peaks, after = [], []
+    peaks, tops, after = [], [], []    # E_m's peak a period, the peak's frame, the works
     # read from the kick on, else where the case's fit starts (after a disordered start's melt)
     first = int(round(a.kick)) if a.kick > 0 else (1 if tc.DISORDER[a.dim] > 0 else 0)
     for k in range(int(round(a.periods))):
@@ -216,6 +224,7 @@ def main() -> None:
         work["rest"] = float(np.mean([r["E_rest"] for r, keep in zip(rows, m) if keep])) / mean_E
         if k >= first:
             after.append(work)
+            tops.append(int(np.flatnonzero(m)[np.argmax(E[m])]))
         cut = " (ends at the kick: not read)" if a.kick > 0 and k == first - 1 else ""
         print(f"{k} | {work['pressure']:+.2f} {work['viscosity']:+.2f} {work['stress']:+.2f} "
               f"{sum(work[q] for q in names):+.2f} | "
@@ -234,9 +243,6 @@ def main() -> None:
         for q in ("stress", "zeroth")))
     # from one peak of E_m to the next (the drop round, its surface energy at its least):
     # the kinetic energy's change and each force's work on every particle's motion
-    tops = [int(np.flatnonzero((t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12))[
-        np.argmax(E[(t >= k * period - 1e-12) & (t <= (k + 1) * period + 1e-12)])])
-        for k in range(first, int(round(a.periods)))]
     for k0, k1 in zip(tops, tops[1:]):
         seg = slice(k0, k1 + 1)
         mean_E = E[seg].mean()
