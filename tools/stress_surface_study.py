@@ -665,8 +665,10 @@ def tolman_member(base, delta: float):
     """``base`` with ``--tolman-pass DELTA`` (the study that led to C5, with C5 itself off):
     each free-surface particle's tension (its g, so T_i)
     times s_i = clamp(1 - DELTA l0 H_i, 1/2, 3/2), H_i the mean curvature from the unit
-    normals n = g/|g| of its neighbours, H_i = -sum_j (n_j - n_i) . r_ij f / sum_j |r_t|^2 f
-    (r_t: r_ij's part in i's tangent plane; 1/r on a sphere or a circle of radius r): a
+    normals n = g/|g| of its neighbours, C5's (stress.normal_divergence_terms: H_i = -sum_j
+    n_j . r_t f / sum_j |r_t|^2 f since 2026-12-06; VALIDATION's "C5" figures of this study
+    were read with the whole (n_j - n_i) . r_ij in the numerator; r_t: r_ij's part in i's
+    tangent plane; 1/r on a sphere or a circle of radius r): a
     Tolman-like correction sigma (1 - delta H) for a surface of tension that sits DELTA l0
     inside the liquid's. A third pass between pass 1 and pass 2; the pairs stay antisymmetric."""
     from crowndemo.core.state import FLUID, GONE

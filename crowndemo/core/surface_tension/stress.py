@@ -49,9 +49,12 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    balance: the sum form's push of a uniform pressure on a face particle, 2 P G/n0 d, equals
    its own pull at F = n0/(2 d G) = 1.016 (2D) / 1.011 (3D). It needs no pass: a_i is pass 2's;
 4. the curvature correction (C5): particle i's tension T_i is taken s_i = clamp(1 - delta l0
-   H_i, 1/2, 3/2) times, H_i the mean curvature from the divergence of the unit normals n =
-   g/|g| over its neighbours within re, H_i = -sum_j (n_j - n_i) . r_ij f / sum_j |r_t|^2 f
-   (r_t: r_ij's part in i's tangent plane; 1/r on a sphere or circle of radius r). In a 3D
+   H_i, 1/2, 3/2) times, H_i the mean curvature from the tangential divergence of the unit
+   normals n = g/|g| over its neighbours within re, H_i = -sum_j n_j . r_t f / sum_j |r_t|^2 f
+   (r_t: r_ij's part in i's tangent plane, so n_j . r_t = (n_j - n_i) . r_t; for radial normals
+   the neighbours' 1/r, 1/r on a sphere or circle of radius r; the whole (n_j - n_i) . r_ij,
+   the form to 2026-12-06, added the normals' second-order turn along the depth and read a
+   rough surface's scatter as curvature, VALIDATION.md). In a 3D
    drop the pull lands about a spacing inside the liquid's surface and the inside pressure
    read 2 sigma/(R - 0.9 l0) (+17 / +8 / +5 % at R/l0 = 8 / 12 / 16), and the mode-2
    frequency as high: a surface of tension delta inside the liquid's, as Tolman's (1949) for a
@@ -112,10 +115,13 @@ def stress_times(g, r):
 
 @ti.func
 def normal_divergence_terms(ni, nj, rij, w):
-    """A pair's share of C5's curvature sums: [(n_j - n_i) . r_ij w, |r_t|^2 w], r_t r_ij's part
-    in i's tangent plane (unit normals n_i, n_j); H_i = -(first sum)/(second sum)."""
+    """A pair's share of C5's curvature sums: [n_j . r_t w, |r_t|^2 w], r_t r_ij's part in i's
+    tangent plane (unit normals n_i, n_j); H_i = -(first sum)/(second sum). n_j . r_t is the
+    normals' change (n_j - n_i) along r_t: the whole (n_j - n_i) . r_ij would add (1 - n_i . n_j)
+    r_ij . n_i, the normals' turn to second order along the depth, which on a rough surface's
+    scattered normals reads as curvature (module docstring, C5)."""
     rt = rij - rij.dot(ni) * ni
-    return ti.Vector([(nj - ni).dot(rij) * w, rt.dot(rt) * w])
+    return ti.Vector([nj.dot(rt) * w, rt.dot(rt) * w])     # (n_j - n_i) . r_t = n_j . r_t
 
 
 @ti.func
