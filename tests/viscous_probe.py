@@ -7,8 +7,7 @@ import numpy as np
 from crowndemo.core import Numerics, Physics, Simulator
 from crowndemo.core.lattice import lattice_offsets, weight
 from crowndemo.core.params import with_values
-from crowndemo.scenes.base import lattice_block
-from crowndemo.scenes.drop import disordered
+from crowndemo.scenes.drop import ball
 
 L0 = 2.0 ** -9          # a power of two: lattice positions are exact in float
 RE_RATIO = 2.1
@@ -29,9 +28,7 @@ def disordered_ball(dim: int, radius_l0: float, jitter: float) -> np.ndarray:
     """The drop cases' start (scenes/drop.oscillating_drop's): the lattice points within
     radius_l0 L0 of the centre, each moved by up to jitter L0 along each axis (scenes'
     seeded disorder)."""
-    r = radius_l0 * L0
-    pts = lattice_block([-r] * dim, [r] * dim, L0)
-    return disordered(pts[np.linalg.norm(pts, axis=1) <= r], L0, jitter)
+    return ball(dim, radius_l0 * L0, L0, jitter)
 
 
 def probe_simulator(dim: int, count: int, viscosity: str) -> Simulator:

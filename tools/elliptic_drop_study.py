@@ -38,8 +38,8 @@ def main() -> None:
     from crowndemo import backend
     backend.init("cpu", threads=a.threads)
     from crowndemo.core import Numerics, Physics
-    from crowndemo.scenes.base import assemble, lattice_block
-    from crowndemo.scenes.drop import disordered
+    from crowndemo.scenes.base import assemble
+    from crowndemo.scenes.drop import ball
     from crowndemo.validate.cases import simulator
     here = os.path.dirname(os.path.abspath(__file__))
     spec = importlib.util.spec_from_file_location("mode_power_study",
@@ -49,8 +49,7 @@ def main() -> None:
 
     l0, g = R / a.scale, a.strain_rate
     t_end = a.strain / g
-    pts = lattice_block([-R] * 3, [R] * 3, l0)
-    pts = disordered(pts[np.linalg.norm(pts, axis=1) <= R], l0, a.disorder)
+    pts = ball(3, R, l0, a.disorder)
     vel = pts @ (g * np.diag([-1.0, -1.0, 2.0])).T
     c = 20.0 * 2.0 * g * R
     physics = Physics(dim=3, l0=l0, v_max=2.0 * g * R, gravity=0.0, sound_speed=c, rho=1000.0,

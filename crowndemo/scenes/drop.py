@@ -39,6 +39,13 @@ def disordered(pts: np.ndarray, l0: float, amount: float,
     return pts + amount * l0 * rng.uniform(-1.0, 1.0, pts.shape)
 
 
+def ball(dim: int, radius: float, l0: float, disorder: float = 0.0) -> np.ndarray:
+    """The drops' particles: the lattice points within ``radius`` of the centre, moved by
+    ``disordered`` when ``disorder`` > 0."""
+    pts = lattice_block([-radius] * dim, [radius] * dim, l0)
+    return disordered(pts[np.linalg.norm(pts, axis=1) <= radius], l0, disorder)
+
+
 def drop_sound_speed(l0: float, sigma: float, rho: float) -> float:
     """A sound speed at which the potential model's bulk cohesion, about 3 sigma/l0, compresses
     the liquid by ~COMPRESSION: c^2 rho COMPRESSION = 3 sigma / l0 (S17)."""
@@ -57,8 +64,7 @@ def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
     liq = {**WATER, **liquid}
     omega = mode2_omega(dim, radius, liq["sigma"], liq["rho"])
     A = 0.5 * amplitude * omega
-    pts = lattice_block([-radius] * dim, [radius] * dim, l0)
-    pts = disordered(pts[np.linalg.norm(pts, axis=1) <= radius], l0, disorder)
+    pts = ball(dim, radius, l0, disorder)
     vel = np.zeros_like(pts)
     if dim == 2:
         vel[:, 0], vel[:, 1] = 2 * A * pts[:, 0], -2 * A * pts[:, 1]
