@@ -71,8 +71,9 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
     ``arch`` falls back to ``$CROWNDEMO_ARCH`` and then to ``cpu``. ``auto`` is CUDA where
     Taichi finds it, else the CPU. ``single_thread`` makes CPU runs bit-reproducible.
     ``fast_compile`` (None: ``$CROWNDEMO_FAST_COMPILE`` = 1, true, yes or on) turns Taichi's advanced IR
-    optimisations off on the CPU arch: the 3D crown step compiles in 13-19 s instead of
-    46-55 s and runs 5-10 % slower (BENCHMARKS.md, "Compiling"); no effect on other archs.
+    optimisations off on the CPU arch and has the grid walk loop over its rows (core/grid.py):
+    the 3D crown step compiles in about 5 s instead of 20-92 s and steps 5-15 % slower
+    (BENCHMARKS.md, "Compiling" and "The walk's rows in a loop"); no effect on other archs.
     ``threads``: the CPU arch's thread count (a sweep's Dask worker: its share of the cores;
     ``single_thread`` is 1). A second call with the same settings is a no-op; with other
     settings Taichi is reset.
@@ -124,6 +125,13 @@ def init(arch: Optional[str] = None, precision: str = "f32", seed: int = 0,
     _current = Backend(arch, resolved, precision, int(seed), bool(single_thread),
                        bool(fast_compile), threads)
     return _current
+
+
+def fast_compiling() -> bool:
+    """Whether the running backend compiles fast (``fast_compile`` on the CPU arch): kernels
+    then also loop over the grid walk's rows instead of unrolling them (core/grid.py)."""
+    b = current()
+    return b.fast_compile and b.resolved in ("x64", "arm64")
 
 
 def current() -> Backend:

@@ -1,6 +1,7 @@
 """The backend choice (crowndemo.backend): ``auto`` never lands on Mesa's software Vulkan;
 ``--fast-compile`` turns Taichi's advanced IR optimisations off on the CPU arch only
-(BENCHMARKS.md, "Compiling": the 3D crown step compiles in about a third of the time)."""
+(BENCHMARKS.md, "Compiling" and "The walk's rows in a loop": the 3D crown step compiles in
+a fraction of the time)."""
 import pytest
 import taichi as ti
 from taichi.lang.misc import is_arch_supported
@@ -28,7 +29,9 @@ def test_fast_compile_on_the_cpu_only(monkeypatch):
     monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
     try:
         assert backend.init("cpu").fast_compile is False and advanced()
+        assert not backend.fast_compiling()       # the grid walk unrolls its rows
         assert backend.init("cpu", fast_compile=True).fast_compile and not advanced()
+        assert backend.fast_compiling()           # and loops over them (core/grid.py)
         monkeypatch.setenv("CROWNDEMO_FAST_COMPILE", "1")
         assert backend.init("cpu").fast_compile and not advanced()
         try:
@@ -37,6 +40,7 @@ def test_fast_compile_on_the_cpu_only(monkeypatch):
             pass                          # no Vulkan device here
         else:
             assert advanced()             # other archs keep Taichi's optimisations
+            assert not backend.fast_compiling()
     finally:
         monkeypatch.delenv("CROWNDEMO_FAST_COMPILE", raising=False)
         backend.init("cpu")

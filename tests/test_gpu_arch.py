@@ -12,7 +12,7 @@ a GPU. An arch that Taichi does not find is skipped, saying why.
   same discrete equations on both, so the runs differ by float32 rounding only (summation
   order, fused multiply-adds), amplified over the steps; a missing term or a broken pass
   differs at order one. The CPU side compiles with ``fast_compile`` (the same equations; the
-  3D step compiles in a third of the time).
+  3D step compiles in a fraction of the time).
 """
 import numpy as np
 import pytest

@@ -11,7 +11,7 @@ import pytest
 import taichi as ti
 
 from crowndemo.core import FLUID, GONE, Numerics, Physics, Simulator
-from crowndemo.core.grid import min_cells, row_reach
+from crowndemo.core.grid import CellGrid, min_cells, row_reach, stencil_rows
 
 L0 = 1.0e-3
 RE_RATIO = 2.1
@@ -25,11 +25,13 @@ class Walker:
     row-clipping for_each_near of the collision model; with ``wide``, the surface stress's
     for_each_wide) visits (count -1: not walked)."""
 
-    def __init__(self, sim: Simulator, near: bool = False, wide: bool = False):
+    def __init__(self, sim: Simulator, near: bool = False, wide: bool = False,
+                 grid: CellGrid = None):
         cap = sim.state.capacity
         self.nbr = ti.field(ti.i32, (cap, MAX_NBR))
         self.count = ti.field(ti.i32, cap)
-        nbr, count, grid, state = self.nbr, self.count, sim.grid, sim.state
+        nbr, count, state = self.nbr, self.count, sim.state
+        grid = sim.grid if grid is None else grid
 
         @ti.func
         def record(i, j, rij, r2, acc: ti.template()):
@@ -303,7 +305,7 @@ def test_row_clipped_walk_matches_brute_force(sims, dim, radius_l0, reach):
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("reach", REACHES)
 def test_stencil_holds_every_pair_within_re(dim, reach):
-    """The walk's compile-time stencil (``row_reach``): for random points x in a cell of side
+    """The walk's stencil (``row_reach``): for random points x in a cell of side
     h = re/k and random y within re of x, y's cell lies in a row the walk visits and within
     that row's reach along axis 0; and the stencil is no larger than it must be: every cell
     it visits can hold such a pair (a point pair at the cells' nearest corners)."""
@@ -329,6 +331,47 @@ def test_stencil_holds_every_pair_within_re(dim, reach):
     # with two offsets of +-3 and the third +-2 or +-3 (nearest-corner distance
     # sqrt(2^2 + 2^2 + 1) h >= 3 h = re): 3 x 8 + 8 = 32 of 343; for k <= 2 none
     assert visited == {2: {1: 9, 2: 25, 3: 49}, 3: {1: 27, 2: 125, 3: 343 - 32}}[dim][reach]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("reach", REACHES)
+def test_the_walks_table_is_the_stencil(dim, reach):
+    """The table of rows the walk loops over at run time (``stencil_rows``): rows in the
+    block's order (offsets on axes 1..d-1 increasing, as the unrolled walk visited them, so
+    that sums keep their order), each with its ``row_reach``, and for the walk at re the
+    cells the stencil test above counts (all of the (2k + 1)^d block but 32 for k = 3 in 3D);
+    the wide walk to 3 l0 visits more."""
+    table = stencil_rows(dim, reach).to_numpy()
+    offsets = [tuple(r[:-1]) for r in table]
+    assert offsets == sorted(set(offsets))
+    assert all(r[-1] == row_reach(tuple(r[:-1]), reach) >= 0 for r in table)
+    assert (2 * table[:, -1] + 1).sum() == {2: {1: 9, 2: 25, 3: 49},
+                                            3: {1: 27, 2: 125, 3: 343 - 32}}[dim][reach]
+    wide = stencil_rows(dim, reach * 3.0 / 2.1).to_numpy()
+    assert all(r[-1] == row_reach(tuple(r[:-1]), reach * 3.0 / 2.1) >= 0 for r in wide)
+    assert (2 * wide[:, -1] + 1).sum() > (2 * reach + 1) ** dim
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("reach", REACHES)
+def test_the_walks_loop_visits_the_unrolled_walks_pairs_in_order(sims, dim, reach):
+    """The walk with its rows in a loop (``rows_in_loop``, the fast-compiling backend's) and
+    unrolled (the default): every particle's neighbours, in the same order (so that sums over
+    them round alike), and both exact against the brute force; a grown cell side too."""
+    pos = random_cloud(dim, seed=70 + dim, far_re=30.0, **CLOUD[dim])
+    kind = np.full(len(pos), FLUID, dtype=np.int32)
+    for max_cells in (BIG[dim], SMALL):
+        sim, walker = load(sims, dim, max_cells, pos, kind, reach=reach)
+        other = CellGrid(sim.state, max_cells, reach, rows_in_loop=not sim.grid.rows_in_loop)
+        sim.grid.build(RE)
+        other.build(RE)
+        assert other.side[None] == sim.grid.side[None]
+        count, nbr = walker.pairs(RE)
+        count_other, nbr_other = Walker(sim, grid=other).pairs(RE)
+        assert (count == count_other).all() and count.sum() > 5 * len(pos)
+        for i in range(len(pos)):
+            assert (nbr[i, :count[i]] == nbr_other[i, :count[i]]).all(), f"particle {i}"
+        check_against_brute_force(sim, Walker(sim, grid=other), as_loaded(sim), kind)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

@@ -99,9 +99,10 @@ def backend_options() -> argparse.ArgumentParser:
     g.add_argument("--single-thread", action="store_true",
                    help="one CPU thread: bit-identical results from run to run")
     g.add_argument("--fast-compile", action="store_true", default=None,
-                   help="CPU arch: compile in about a third of the time (Taichi's advanced "
-                        "IR optimisations off), steps 5-10 %% slower; for first and short "
-                        "runs (default: $CROWNDEMO_FAST_COMPILE=1, else off)")
+                   help="CPU arch: compile in a fraction of the time (Taichi's advanced "
+                        "IR optimisations off, the grid walk's rows in a loop: a 3D model in "
+                        "about 5 s), steps 5-15 %% slower; for first and short runs "
+                        "(default: $CROWNDEMO_FAST_COMPILE=1, else off)")
     return p
 
 

@@ -184,7 +184,7 @@ def _validate(args, argv) -> int:
     out = os.path.join(repo_root(), "reports") if args.out is None else args.out
     require_folder("--out", out)
     if args.quick and args.fast_compile is None and "CROWNDEMO_FAST_COMPILE" not in os.environ:
-        args.fast_compile = True        # a check, not a timing: compile in a third of the time
+        args.fast_compile = True        # a check, not a timing: compile in a fraction of the time
     be = start_backend(args)
 
     def say(text):

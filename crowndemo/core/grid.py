@@ -5,9 +5,14 @@ cell, a blocked prefix sum that runs on the CPU and GPU archs alike (blocks.py; 
 PrefixSumExecutor does not run on the CPU), then a scatter into ``order`` (particle indices in
 cell order). Cells have side h >= re/k (k = ``cells_per_re``), so every neighbour within re
 lies within k cells on each axis. The walk visits only the cells of that (2k + 1)^d block that
-can hold a point within re of the particle's own cell (a stencil fixed at compile time: all 125
-for k = 2, 311 of 343 for k = 3), row by row along axis 0, where cells are contiguous in cell
-order. The grid is padded with k empty cells on every side, so a row never needs a bounds test.
+can hold a point within re of the particle's own cell (a stencil fixed when the grid is made:
+all 125 for k = 2, 311 of 343 for k = 3), row by row along axis 0, where cells are contiguous
+in cell order. The walk unrolls its rows (a copy of the pair task for each), or, where the
+backend compiles fast (``--fast-compile``, ``$CROWNDEMO_FAST_COMPILE``: first and short runs,
+the test suite), loops over a small table of them at run time: one copy of the task, so the 3D
+kernels compile in a fraction of the time, and the crown steps 5-15 % slower (BENCHMARKS.md,
+"The walk's rows in a loop"). The collision's walk (clipped rows, a small task) unrolls always.
+The grid is padded with k empty cells on every side, so a row never needs a bounds test.
 A grid made ``wide`` (> 1) also has a second, wider walk (``for_each_wide``) to wide x re, for a
 pass whose pair kernel reaches beyond re (the surface stress's divergence, C3): its stencil is
 the cells within ceil(k wide) of the centre that can hold such a point, and the padding is that
@@ -16,18 +21,22 @@ If the live particles spread so far that the cells would not fit in ``max_cells`
 grows: the walk stays exact, only more candidate pairs are visited.
 """
 
+import itertools
 import math
 import warnings
-from typing import Iterable
+from typing import Iterable, Optional
 
+import numpy as np
 import taichi as ti
 
+from ..backend import fast_compiling
 from .blocks import BLOCK, blocks_for, exclusive_scan, groups_for, larger, reduce_blocks, smaller
 from .state import GONE, ParticleState
 
 
-# the walk unrolls its rows on purpose (49 for cells_per_re = 3 in 3D): Taichi's warning past 32
-# unrolled iterations says nothing a user can act on
+# the walk unrolls its rows on purpose (49 for cells_per_re = 3 in 3D) unless it loops over
+# them (``rows_in_loop``): Taichi's warning past 32 unrolled iterations says nothing a user can
+# act on
 warnings.filterwarnings("ignore", message="You are unrolling more than", category=SyntaxWarning)
 
 
@@ -61,6 +70,18 @@ def span_cells(cells_per_re: int, wide: float = 1.0) -> int:
     return cells_spanned(cells_per_re * max(wide, 1.0))
 
 
+def stencil_rows(dim: int, span: float) -> ti.Field:
+    """The rows of the walk to ``span`` cells that can hold a neighbour, in the order the
+    walk visits them: a field of (offsets on axes 1..dim-1, row_reach) per row."""
+    k = cells_spanned(span)
+    rows = [off + (row_reach(off, span),)
+            for off in itertools.product(range(-k, k + 1), repeat=dim - 1)
+            if row_reach(off, span) >= 0]
+    field = ti.field(ti.i32, shape=(len(rows), dim))
+    field.from_numpy(np.array(rows, dtype=np.int32).reshape(len(rows), dim))
+    return field
+
+
 def min_cells(dim: int, cells_per_re: int, wide: float = 1.0) -> int:
     """The fewest cells a grid needs: one cell with its padding and one to spare per axis, so
     that a growing cell side always ends within the limit."""
@@ -70,8 +91,10 @@ def min_cells(dim: int, cells_per_re: int, wide: float = 1.0) -> int:
 @ti.data_oriented
 class CellGrid:
     def __init__(self, state: ParticleState, max_cells: int, cells_per_re: int = 2,
-                 wide: float = 1.0):
+                 wide: float = 1.0, rows_in_loop: Optional[bool] = None):
         d = self.dim = state.dim
+        # None: loop over the rows where the backend compiles fast (module docstring)
+        self.rows_in_loop = fast_compiling() if rows_in_loop is None else bool(rows_in_loop)
         self.reach = int(cells_per_re)      # cells of side re/reach; walk (2 reach + 1)^d
         self.wide = max(float(wide), 1.0)   # for_each_wide's radius over re
         self.pad = span_cells(self.reach, self.wide)   # empty cells on every side
@@ -106,6 +129,10 @@ class CellGrid:
         # contiguous array and looks up j = order[s] only for the pairs within reach (a
         # quarter of the candidates). Positions must not change between a build and a walk.
         self.sorted_pos = ti.Vector.field(d, float, state.capacity)
+        # the stencils' rows for the walk's loop (rows_in_loop): each row's cell offsets on
+        # axes 1..d-1 and its reach
+        self.rows = stencil_rows(d, self.reach)
+        self.wide_rows = stencil_rows(d, self.reach * self.wide)
 
     def set_cell_limit(self, cells: int) -> None:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
@@ -270,6 +297,10 @@ class CellGrid:
         visited. (Clipping costs more per row than it saves at radius re: BENCHMARKS.md.)"""
         self._walk(i, xi, r2_max, task, acc, True, self.reach)
 
+    def _rows_for(self, span: float) -> ti.Field:
+        """The table of rows of the walk to ``span`` cells (the grid's two walks)."""
+        return self.rows if span == self.reach else self.wide_rows
+
     @ti.func
     def _walk(self, i, xi, re2, task: ti.template(), acc: ti.template(), clip: ti.template(),
               span: ti.template()):
@@ -282,17 +313,27 @@ class CellGrid:
         for m in ti.static(range(1, d)):
             stride[m] = stride[m - 1] * self.dims[m - 1]
         centre = self.linear(c)
-        for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
-            reach = ti.static(row_reach(off, span))
-            if ti.static(reach >= 0):      # rows that cannot hold a neighbour are not compiled
-                first = centre - reach     # the row's first cell
+        if ti.static(self.rows_in_loop and not clip):
+            rows = ti.static(self._rows_for(span))
+            for r in range(rows.shape[0]):      # a loop at run time: one copy of the task
+                reach = rows[r, d - 1]
+                first = centre - reach          # the row's first cell
                 for m in ti.static(range(1, d)):
-                    first += off[m - 1] * stride[m]
-                if ti.static(clip):
-                    self._clipped_row(i, xi, re2, c, h, off, first, reach, task, acc)
-                else:
-                    self._row(i, xi, re2, self.cell_start[first],
-                              self.cell_start[first + 2 * reach + 1], task, acc)
+                    first += rows[r, m - 1] * stride[m]
+                self._row(i, xi, re2, self.cell_start[first],
+                          self.cell_start[first + 2 * reach + 1], task, acc)
+        else:
+            for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
+                reach = ti.static(row_reach(off, span))
+                if ti.static(reach >= 0):      # rows that cannot hold a neighbour are not compiled
+                    first = centre - reach     # the row's first cell
+                    for m in ti.static(range(1, d)):
+                        first += off[m - 1] * stride[m]
+                    if ti.static(clip):
+                        self._clipped_row(i, xi, re2, c, h, off, first, reach, task, acc)
+                    else:
+                        self._row(i, xi, re2, self.cell_start[first],
+                                  self.cell_start[first + 2 * reach + 1], task, acc)
 
     @ti.func
     def _clipped_row(self, i, xi, re2, c, h, off: ti.template(), first, reach: ti.template(),
