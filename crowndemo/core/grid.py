@@ -70,16 +70,14 @@ def span_cells(cells_per_re: int, wide: float = 1.0) -> int:
     return cells_spanned(cells_per_re * max(wide, 1.0))
 
 
-def stencil_rows(dim: int, span: float) -> ti.Field:
+def stencil_rows(dim: int, span: float) -> np.ndarray:
     """The rows of the walk to ``span`` cells that can hold a neighbour, in the order the
-    walk visits them: a field of (offsets on axes 1..dim-1, row_reach) per row."""
+    walk visits them: (offsets on axes 1..dim-1, row_reach) per row."""
     k = cells_spanned(span)
     rows = [off + (row_reach(off, span),)
             for off in itertools.product(range(-k, k + 1), repeat=dim - 1)
             if row_reach(off, span) >= 0]
-    field = ti.field(ti.i32, shape=(len(rows), dim))
-    field.from_numpy(np.array(rows, dtype=np.int32).reshape(len(rows), dim))
-    return field
+    return np.array(rows, dtype=np.int32).reshape(len(rows), dim)
 
 
 def min_cells(dim: int, cells_per_re: int, wide: float = 1.0) -> int:
@@ -129,10 +127,13 @@ class CellGrid:
         # contiguous array and looks up j = order[s] only for the pairs within reach (a
         # quarter of the candidates). Positions must not change between a build and a walk.
         self.sorted_pos = ti.Vector.field(d, float, state.capacity)
-        # the stencils' rows for the walk's loop (rows_in_loop): each row's cell offsets on
-        # axes 1..d-1 and its reach
-        self.rows = stencil_rows(d, self.reach)
-        self.wide_rows = stencil_rows(d, self.reach * self.wide)
+        # the stencils' rows for the walk's loop (rows_in_loop), filled at the first build
+        self.rows = self.wide_rows = None
+        if self.rows_in_loop:
+            self._row_tables = [stencil_rows(d, self.reach),
+                                stencil_rows(d, self.reach * self.wide)]
+            self.rows, self.wide_rows = (ti.field(ti.i32, shape=t.shape)
+                                         for t in self._row_tables)
 
     def set_cell_limit(self, cells: int) -> None:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
@@ -149,6 +150,10 @@ class CellGrid:
     def build(self, min_side: float, reorder: bool = False) -> None:
         """Rebuild at the current positions; with ``reorder`` permute the particles into cell
         order (every persistent field, through the state's registry)."""
+        if self.rows_in_loop and self._row_tables:
+            for field, table in zip((self.rows, self.wide_rows), self._row_tables):
+                field.from_numpy(table)
+            self._row_tables = None
         self._plan(min_side / self.reach)
         self._sort()
         if reorder:
