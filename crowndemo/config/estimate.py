@@ -74,7 +74,8 @@ SURFACE_TENSION_COST = {"potential": 1.0, "stress": 3.11, "curvature": 1.26}
 # A preset's first step compiles the crown step's kernels. With Taichi's offline cache empty
 # (`crowndemo run quick-2d|quick --max-steps 1`, TI_OFFLINE_CACHE_FILE_PATH an empty folder,
 # 2026-11-23, this CPU): 4.9 s in 2D, 51.5 s in 3D (about 5 s with --fast-compile, BENCHMARKS.md
-# "The walk's rows in a loop"; the stress member's 92 s without it). A run whose kernels are cached starts in 3-9 s: the estimates are a first run's.
+# "The walk's rows in a loop"; the stress member's 92 s without it). A run whose kernels are
+# cached starts in 3-9 s: the estimates are a first run's.
 FIRST_RUN_COMPILE_S = {2: 5.0, 3: 50.0}
 
 
