@@ -127,13 +127,14 @@ class CellGrid:
         # contiguous array and looks up j = order[s] only for the pairs within reach (a
         # quarter of the candidates). Positions must not change between a build and a walk.
         self.sorted_pos = ti.Vector.field(d, float, state.capacity)
-        # the stencils' rows for the walk's loop (rows_in_loop), filled at the first build
+        # the stencils' rows for the walk's loop (rows_in_loop), filled at the first build (no
+        # kernel launch while the simulator's fields are being made)
         self.rows = self.wide_rows = None
+        self._unfilled = []                 # (field, table) still to copy to the device
         if self.rows_in_loop:
-            self._row_tables = [stencil_rows(d, self.reach),
-                                stencil_rows(d, self.reach * self.wide)]
-            self.rows, self.wide_rows = (ti.field(ti.i32, shape=t.shape)
-                                         for t in self._row_tables)
+            tables = (stencil_rows(d, self.reach), stencil_rows(d, self.reach * self.wide))
+            self.rows, self.wide_rows = (ti.field(ti.i32, shape=t.shape) for t in tables)
+            self._unfilled = list(zip((self.rows, self.wide_rows), tables))
 
     def set_cell_limit(self, cells: int) -> None:
         """Use at most ``cells`` cells (at most those allocated): a run-time value, so that a
@@ -150,10 +151,9 @@ class CellGrid:
     def build(self, min_side: float, reorder: bool = False) -> None:
         """Rebuild at the current positions; with ``reorder`` permute the particles into cell
         order (every persistent field, through the state's registry)."""
-        if self.rows_in_loop and self._row_tables:
-            for field, table in zip((self.rows, self.wide_rows), self._row_tables):
-                field.from_numpy(table)
-            self._row_tables = None
+        for field, table in self._unfilled:
+            field.from_numpy(table)
+        self._unfilled = []
         self._plan(min_side / self.reach)
         self._sort()
         if reorder:
