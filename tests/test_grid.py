@@ -336,9 +336,9 @@ def test_stencil_holds_every_pair_within_re(dim, reach):
 @pytest.mark.parametrize("dim", [2, 3])
 @pytest.mark.parametrize("reach", REACHES)
 def test_the_walks_table_is_the_stencil(dim, reach):
-    """The table of rows the walk loops over at run time (``stencil_rows``): rows in the
-    block's order (offsets on axes 1..d-1 increasing, as the unrolled walk visited them, so
-    that sums keep their order), each with its ``row_reach``, and for the walk at re the
+    """The table of the walk's rows (``stencil_rows``; the unrolled walk compiles a copy of
+    the pass for each, the loop walks it at run time): rows in the block's order (offsets on
+    axes 1..d-1 increasing), each with its ``row_reach``, and for the walk at re the
     cells the stencil test above counts (all of the (2k + 1)^d block but 32 for k = 3 in 3D);
     the wide walk to 3 l0 visits more."""
     table = stencil_rows(dim, reach)

@@ -311,7 +311,6 @@ class CellGrid:
               span: ti.template()):
         """The stencil's rows for a walk radius of ``span`` cells of side re/reach."""
         d = ti.static(self.dim)
-        k = ti.static(cells_spanned(span))
         c = self.cell_of(xi)
         h = self.side[None]
         stride = ti.Vector([1] * d)       # of the cell index along each axis
@@ -328,17 +327,17 @@ class CellGrid:
                 self._row(i, xi, re2, self.cell_start[first],
                           self.cell_start[first + 2 * reach + 1], task, acc)
         else:
-            for off in ti.static(ti.grouped(ti.ndrange(*([(-k, k + 1)] * (d - 1))))):
-                reach = ti.static(row_reach(off, span))
-                if ti.static(reach >= 0):      # rows that cannot hold a neighbour are not compiled
-                    first = centre - reach     # the row's first cell
-                    for m in ti.static(range(1, d)):
-                        first += off[m - 1] * stride[m]
-                    if ti.static(clip):
-                        self._clipped_row(i, xi, re2, c, h, off, first, reach, task, acc)
-                    else:
-                        self._row(i, xi, re2, self.cell_start[first],
-                                  self.cell_start[first + 2 * reach + 1], task, acc)
+            # one unrolled copy of the task per row that can hold a neighbour (the table's rows)
+            for row in ti.static(stencil_rows(d, span).tolist()):
+                off, reach = ti.static(tuple(row[:-1]), row[-1])
+                first = centre - reach         # the row's first cell
+                for m in ti.static(range(1, d)):
+                    first += off[m - 1] * stride[m]
+                if ti.static(clip):
+                    self._clipped_row(i, xi, re2, c, h, off, first, reach, task, acc)
+                else:
+                    self._row(i, xi, re2, self.cell_start[first],
+                              self.cell_start[first + 2 * reach + 1], task, acc)
 
     @ti.func
     def _clipped_row(self, i, xi, re2, c, h, off: ti.template(), first, reach: ti.template(),
