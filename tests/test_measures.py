@@ -14,6 +14,7 @@ from crowndemo import backend
 from crowndemo.core import FLUID, GONE, simulator_for
 from crowndemo.scenes import hydrostatic_tank
 from crowndemo.scenes.drop import mode2_decay, mode2_omega
+from crowndemo.scenes.drop_modes import viscous_mode
 from crowndemo.validate.cases import fluid_pressure_profile
 from crowndemo.core.lattice import lattice_cohesion_pressure
 from crowndemo.validate.observables import LINK_L0, liquid_body, mechanical_pressure, surge_front
@@ -368,3 +369,27 @@ def test_mode2_decay_is_lamb(radius, nu):
                                                        rel=1e-12)
     assert mode2_decay(3, radius, nu) == pytest.approx((n - 1) * (2 * n + 1) * nu / radius ** 2,
                                                        rel=1e-12)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_viscous_mode_tends_to_rayleigh_and_lamb(dim, n):
+    """The free viscous drop's exact mode (scenes/drop_modes.py) as the viscosity vanishes:
+    Rayleigh's frequency and Lamb's decay, the formulas above, for modes 2-4. What the exact
+    mode adds to Lamb's rate comes from the vortical layer under the free surface, of
+    thickness (nu / omega)^(1/2): relative to Lamb's it goes as (nu / (omega R^2))^(1/2), so
+    a hundredth of the viscosity leaves a tenth of it."""
+    radius, sigma, rho = 1.0e-3, 0.0728, 998.0
+    curvature = n * n - 1 if dim == 2 else (n - 1) * (n + 2)
+    omega0 = math.sqrt(n * curvature * sigma / (rho * radius ** 3))
+    lamb = 2 * n * (n - 1) if dim == 2 else (n - 1) * (2 * n + 1)
+    departure = []
+    for eps in (1.0e-4, 1.0e-6):            # nu / (omega0 R^2)
+        nu = eps * omega0 * radius ** 2
+        omega, decay = viscous_mode(dim, n, radius, sigma, rho, nu)
+        assert omega == pytest.approx(omega0, rel=eps)
+        departure.append(1.0 - decay / (lamb * nu / radius ** 2))
+    assert 0.0 < departure[1] < departure[0] < 0.05
+    assert departure[0] / departure[1] == pytest.approx(10.0, rel=0.02)
+    assert viscous_mode(dim, n, radius, sigma, rho, 0.0) == (pytest.approx(omega0, rel=1e-12),
+                                                             0.0)

@@ -203,7 +203,8 @@ def _oscillation(dim: int) -> Case:
         omega, decay = oscillation.fit(ts, ss)
         ref, ref_decay = scene.info["omega_rad_s"], scene.info["decay_1_s"]
         err = abs(omega / ref - 1) if math.isfinite(omega) else math.inf
-        return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay})
+        return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay,
+                                              "decay_exact_1_s": scene.info["decay_exact_1_s"]})
 
     return Case(f"drop-oscillation-{dim}d", dim, "mode-2 angular frequency [rad/s]",
                 "Rayleigh-Lamb (method.md §7)", "R/l0",

@@ -24,7 +24,8 @@ def _fmt(v) -> str:
 # extras shown under a case's table, one line per run (errors as per cent)
 SHOWN_EXTRAS = {"time origin dT": "{:.3g}", "worst without dT": "{:.2%}",
                 "turn_rad": "{:.3g}", "drift_over_R": "{:.2g}", "p_in_over_laplace": "{:.3f}",
-                "decay_1_s": "{:.3g}", "decay_ref_1_s": "{:.3g}", "ejected": "{:d}"}
+                "decay_1_s": "{:.3g}", "decay_ref_1_s": "{:.3g}",
+                "decay_exact_1_s": "{:.3g}", "ejected": "{:d}"}
 
 
 def _shown_extras(r) -> str:

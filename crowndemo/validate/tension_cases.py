@@ -182,6 +182,8 @@ def _oscillation(dim: int) -> Case:
         ref, ref_decay = scene.info["omega_rad_s"], scene.info["decay_1_s"]
         err = abs(omega / ref - 1) if math.isfinite(omega) else math.inf
         return Outcome(omega, ref, err, sim, {"decay_1_s": decay, "decay_ref_1_s": ref_decay,
+                                              "decay_exact_1_s": scene.info["decay_exact_1_s"],
+                                              "omega_exact_rad_s": scene.info["omega_exact_rad_s"],
                                               "drift_over_R": watch.drift() / R,
                                               "ejected": watch.ejected[-1]})
 
