@@ -206,7 +206,9 @@ def main() -> None:
     print(f"{a.dim}D drop, R/l0 = {a.scale:g}, {int(scene.kind.size)} particles, nu = {nu:g}, "
           f"sigma = {sigma:g} N/m, c = {c:.3g} m/s, {numerics.viscosity} viscosity; "
           f"omega = {scene.info['omega_rad_s']:.1f} rad/s, T = {period * 1e3:.3f} ms, "
-          f"Lamb's decay {lamb:.1f} 1/s (a loss of {4 * lamb * period:.2f} mean E_m a period)"
+          f"Lamb's decay {lamb:.1f} 1/s (a loss of {4 * lamb * period:.2f} mean E_m a period; "
+          f"the exact viscous mode's {scene.info['decay_exact_1_s']:.1f} 1/s, "
+          f"{scene.info['omega_exact_rad_s']:.1f} rad/s)"
           + (f"; kicked at {a.kick:g} T" if a.kick > 0 else ""))
     print("period | work on the mode's flow / the period's mean E_m: pressure, viscosity, stress, "
           "sum | by layer (" + ", ".join(layers) + "): pressure; stress | the pressure's "

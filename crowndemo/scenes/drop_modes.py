@@ -68,8 +68,9 @@ def _determinant(dim: int, n: int, lam: complex, nu: float, gamma: float) -> com
 def viscous_mode(dim: int, n: int, radius: float, sigma: float, rho: float,
                  nu: float) -> Tuple[float, float]:
     """(omega, decay) of a free drop's shape mode n [rad/s, 1/s]: the oscillation's angular
-    frequency and its amplitude's decay rate, exp(-decay t) cos(omega t). omega = 0 where the
-    mode no longer oscillates."""
+    frequency and its amplitude's decay rate, exp(-decay t) cos(omega t). Beyond the viscosity
+    where the mode stops oscillating (3D mode 2: nu ~ 0.27 omega0 R^2) omega = 0 and decay is
+    the root followed there; ArithmeticError where the root is lost (far beyond it)."""
     if dim not in (2, 3) or n < 2:
         raise ValueError(f"viscous_mode: dim 2 or 3 and n >= 2, got dim={dim}, n={n}")
     curv = (n - 1) * (n + 2) if dim == 3 else n * n - 1
