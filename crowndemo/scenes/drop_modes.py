@@ -34,7 +34,8 @@ def _radial(dim: int, n: int, z: complex) -> Tuple[complex, complex]:
         a, b = np.exp(1j * w - abs(z.imag)), np.exp(-1j * w - abs(z.imag))
         return (a + b) / 2, (a - b) / 2j
     if dim == 3:
-        # j_n by upward recurrence from j_0, j_1 (|z| >= 1 here: stable enough for n <= 4)
+        # j_n by upward recurrence from j_0, j_1: stable while n < |z| = R (omega / nu)^(1/2),
+        # the drop's radius over the vortical layer's thickness (n <= 80 in the tests)
         c, s = cos_sin(z)
         j = [s / z, s / z ** 2 - c / z]
         for m in range(1, n + 1):
@@ -80,8 +81,8 @@ def viscous_mode(dim: int, n: int, radius: float, sigma: float, rho: float,
     gamma = 1.0 / n                                # units: R = 1, omega0 = 1
     nu_hat = nu / (omega0 * radius ** 2)
     lamb = ((n - 1) * (2 * n + 1) if dim == 3 else 2 * n * (n - 1))
-    lam = complex(-lamb * min(nu_hat, 1e-3), 1.0)
     steps = max(1, int(math.ceil(nu_hat / 1e-3)))   # follow the root from small nu
+    lam = complex(-lamb * nu_hat / steps, 1.0)      # Lamb's estimate at the first step
     for s in range(1, steps + 1):
         nu_s = nu_hat * s / steps
         for _ in range(60):
