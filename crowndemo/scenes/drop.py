@@ -10,7 +10,7 @@ import numpy as np
 
 from ..core.params import WATER, Numerics, Physics
 from .base import Scene, assemble, lattice_block
-from .drop_modes import viscous_mode
+from .drop_modes import lamb_decay, rayleigh_omega, viscous_mode
 
 COMPRESSION = 0.01   # the sound speed keeps the cohesion's compression ~1 % (see drop_sound_speed)
 DISORDER_SEED = 1    # the disordered start's random offsets: the same start every run
@@ -19,12 +19,12 @@ DISORDER_SEED = 1    # the disordered start's random offsets: the same start eve
 def mode2_omega(dim: int, radius: float, sigma: float, rho: float) -> float:
     """Angular frequency of the mode-2 oscillation: omega^2 = 8 sigma/(rho R^3) in 3D,
     6 sigma/(rho R^3) in 2D (method.md §7)."""
-    return math.sqrt((8.0 if dim == 3 else 6.0) * sigma / (rho * radius ** 3))
+    return rayleigh_omega(dim, 2, radius, sigma, rho)
 
 
 def mode2_decay(dim: int, radius: float, nu: float) -> float:
     """Viscous decay rate of the mode-2 amplitude: 5 nu/R^2 (3D), 4 nu/R^2 (2D) (method.md §7)."""
-    return (5.0 if dim == 3 else 4.0) * nu / radius ** 2
+    return lamb_decay(dim, 2, radius, nu)
 
 
 def disordered(pts: np.ndarray, l0: float, amount: float,

@@ -26,6 +26,19 @@ import numpy as np
 _QUAD = 256      # points of the trapezoid rule for J_n in 2D (periodic: exponential accuracy)
 
 
+def rayleigh_omega(dim: int, n: int, radius: float, sigma: float, rho: float) -> float:
+    """Rayleigh's angular frequency of mode n, the inviscid limit: omega0^2 = n (n - 1)(n + 2)
+    sigma / (rho R^3) in 3D, n (n^2 - 1) sigma / (rho R^3) in 2D."""
+    restoring = (n - 1) * (n + 2) if dim == 3 else n * n - 1
+    return math.sqrt(n * restoring * sigma / (rho * radius ** 3))
+
+
+def lamb_decay(dim: int, n: int, radius: float, nu: float) -> float:
+    """Lamb's decay rate of mode n's amplitude, the small-viscosity limit: (n - 1)(2 n + 1)
+    nu / R^2 in 3D, 2 n (n - 1) nu / R^2 in 2D."""
+    return ((n - 1) * (2 * n + 1) if dim == 3 else 2 * n * (n - 1)) * nu / radius ** 2
+
+
 def _radial(dim: int, n: int, z: complex) -> Tuple[complex, complex]:
     """(g, dg/dz) of the vortical part's radial function, both times exp(-|Im z|) (the same
     factor, which the determinant's B column drops; unscaled they overflow where nu is
@@ -54,15 +67,14 @@ def _determinant(dim: int, n: int, lam: complex, nu: float, gamma: float) -> com
     curvature's restoring term, so omega0^2 = n gamma)."""
     k = np.sqrt(complex(-lam / nu))
     g, dg = _radial(dim, n, k)
-    dg = k * dg / g                                # d/dr, over g: the B column divided by g
-    g = 1.0
+    q = k * dg / g              # g'(R) / g(R): the B column is divided by g (g -> 1 below)
     L = n * (n + 1) if dim == 3 else n             # u_r = n A r^(n-1) + L B g / r
     shear_a = 2 * (n - 1) if dim == 3 else 2 * n * (n - 1)
     shear_g = 2 * L - 2 if dim == 3 else 2 * n * n
     rows = np.array([
-        [shear_a, -2 * dg - k * k * g + shear_g * g, 0.0],                      # no shear
-        [-lam - 2 * nu * n * (n - 1), -2 * nu * L * (dg - g), -gamma],            # normal stress
-        [n, L * g, -lam]], dtype=complex)                                         # kinematic
+        [shear_a, -2 * q - k * k + shear_g, 0.0],                                # no shear
+        [-lam - 2 * nu * n * (n - 1), -2 * nu * L * (q - 1), -gamma],             # normal stress
+        [n, L, -lam]], dtype=complex)                                             # kinematic
     return complex(np.linalg.det(rows))
 
 
@@ -74,15 +86,13 @@ def viscous_mode(dim: int, n: int, radius: float, sigma: float, rho: float,
     the root followed there; ArithmeticError where the root is lost (far beyond it)."""
     if dim not in (2, 3) or n < 2:
         raise ValueError(f"viscous_mode: dim 2 or 3 and n >= 2, got dim={dim}, n={n}")
-    curv = (n - 1) * (n + 2) if dim == 3 else n * n - 1
-    omega0 = math.sqrt(n * curv * sigma / (rho * radius ** 3))
+    omega0 = rayleigh_omega(dim, n, radius, sigma, rho)
     if nu <= 0.0:
         return omega0, 0.0
     gamma = 1.0 / n                                # units: R = 1, omega0 = 1
     nu_hat = nu / (omega0 * radius ** 2)
-    lamb = ((n - 1) * (2 * n + 1) if dim == 3 else 2 * n * (n - 1))
     steps = max(1, int(math.ceil(nu_hat / 1e-3)))   # follow the root from small nu
-    lam = complex(-lamb * nu_hat / steps, 1.0)      # Lamb's estimate at the first step
+    lam = complex(-lamb_decay(dim, n, 1.0, nu_hat / steps), 1.0)   # Lamb's, at the first step
     for s in range(1, steps + 1):
         nu_s = nu_hat * s / steps
         for _ in range(60):
