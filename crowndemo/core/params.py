@@ -29,8 +29,10 @@ VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 STRESS_PAIR_SUPPORT = 3.0
 # the surface stress's curvature correction sigma (1 - delta H) (method.md C5): delta, per
 # dimension, in l0; the surface of tension sits inside the liquid's surface in 3D drops
-# (VALIDATION.md, "The curvature correction"); 0 compiles it out
-STRESS_TOLMAN = {2: 0.0, 3: 0.92}
+# (VALIDATION.md, "The curvature correction"); 0 compiles it out. 0.80 in 3D: the value at
+# which the resting drop's error falls with resolution (VALIDATION.md, "C5's H from the
+# normals' tangential change"; 0.92, set at R/l0 = 12 alone, over-corrected at 16)
+STRESS_TOLMAN = {2: 0.0, 3: 0.80}
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
