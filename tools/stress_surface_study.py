@@ -75,6 +75,9 @@ member's surface fit instead of the normals' divergence (tolman_fit_member).
 ``energy``; tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound
 speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
 ``--re-ratio X``: every drop's re = X l0 (the cases' 2.1; tools/mode_power_study.py);
+``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
+place of the member's F = 1; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat lattice
+face's balance (face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1 l0);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
@@ -209,6 +212,41 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
                     self.state.pressure[i] = p
 
     return OwnPressureStress
+
+
+def face_balance_factor(dim: int, re_over_l0: float) -> float:
+    """C4's factor F = n0 / (2 d G l0) at which the sum form's push of a uniform pressure on a
+    flat lattice face's particle, 2 d P G / n0 (G the half-lattice's sum of r_z w / r^2),
+    equals its own pull (stress.py C4): 1.016 / 1.011 (2D / 3D) at re = 2.1 l0, the member's 1;
+    1.160 / 1.187 at 3.1 l0 (VALIDATION.md "re = 3.1 l0 with C4's factor from the lattice")."""
+    from crowndemo.core.lattice import lattice_offsets, weight
+    q = lattice_offsets(dim, 1.0, re_over_l0)
+    w = weight(np.linalg.norm(q, axis=1), re_over_l0)
+    below = q[:, -1] < 0
+    G = -float((q[below, -1] * w[below] / (q[below] ** 2).sum(axis=1)).sum())
+    return float(w.sum()) / (2 * dim * G)
+
+
+def c4_factor_member(base, factor: float):
+    """``base`` (the member) with C4's pressure F rho l0 max(0, a_i . g_i/|g_i|), F =
+    ``factor``, in place of the member's F = 1 (``--c4-factor``)."""
+    from crowndemo.core.state import FLUID
+
+    @ti.data_oriented
+    class C4FactorStress(base):
+        @ti.kernel
+        def _surface_pressure(self):
+            scale = factor * self.coef.rho[None] * self.coef.l0[None]
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                g = self.colour[i]
+                gl = g.norm()
+                if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and gl > 0.0:
+                    self.state.pressure[i] = scale * ti.max(self.accel[i].dot(g) / gl, 0.0)
+                if ti.static(self.delta > 0.0):
+                    self.tolman[i] = self.tolman_next[i]      # C5: the next step's s_i
+
+    return C4FactorStress
 
 
 def eos_pressure_member(base, slope: float):
@@ -1095,6 +1133,9 @@ def main() -> None:
                                           "blend", "eos", "cumulative"),
                     default=None, help="the free surface's pressure (default: the base's)")
     ap.add_argument("--own-factor", type=float, default=1.0)
+    ap.add_argument("--c4-factor", default=None,
+                    help="--base member: C4's factor F (a number, or 'lattice': n0/(2 d G l0) "
+                         "at the run's re, face_balance_factor); default the member's 1")
     ap.add_argument("--own-per-area", action="store_true")
     ap.add_argument("--theta-slope", type=float, default=None,
                     help="--surface eos: C in theta = 1 - C |g| l0 (default 0.72 2D, 0.62 3D)")
@@ -1204,6 +1245,13 @@ def main() -> None:
         if a.tolman is not None:
             raise SystemExit("--tolman-pass: not with --tolman")
         member = (tolman_fit_member if a.tolman_fit else tolman_member)(member, a.tolman_pass)
+    if a.c4_factor is not None:
+        if a.base != "member" or a.surface is not None:
+            raise SystemExit("--c4-factor: --base member without --surface")
+        factor = (face_balance_factor(dim, a.re_ratio or 2.1) if a.c4_factor == "lattice"
+                  else float(a.c4_factor))
+        print(f"C4's factor {factor:.4f}", flush=True)
+        member = c4_factor_member(member, factor)
     family.MODELS["stress"] = member
     if a.relaxed_start > 0.0 and a.what != "energy" and (
             a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
