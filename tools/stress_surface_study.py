@@ -229,24 +229,8 @@ def face_balance_factor(dim: int, re_over_l0: float) -> float:
 
 def c4_factor_member(base, factor: float):
     """``base`` (the member) with C4's pressure F rho l0 max(0, a_i . g_i/|g_i|), F =
-    ``factor``, in place of the member's F = 1 (``--c4-factor``)."""
-    from crowndemo.core.state import FLUID
-
-    @ti.data_oriented
-    class C4FactorStress(base):
-        @ti.kernel
-        def _surface_pressure(self):
-            scale = factor * self.coef.rho[None] * self.coef.l0[None]
-            for at in range(self.state.n[None]):
-                i = self.state.spread(at)
-                g = self.colour[i]
-                gl = g.norm()
-                if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and gl > 0.0:
-                    self.state.pressure[i] = scale * ti.max(self.accel[i].dot(g) / gl, 0.0)
-                if ti.static(self.delta > 0.0):
-                    self.tolman[i] = self.tolman_next[i]      # C5: the next step's s_i
-
-    return C4FactorStress
+    ``factor``, in place of the member's F = 1 (``--c4-factor``; StressTension.surface_factor)."""
+    return ti.data_oriented(type("C4FactorStress", (base,), {"surface_factor": float(factor)}))
 
 
 def eos_pressure_member(base, slope: float):

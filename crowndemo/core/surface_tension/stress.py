@@ -142,6 +142,9 @@ class StressTension:
     name = "stress"
     pair_term = False          # acts in the corrector (``corrector_term``), not the predictor
     corrector_term = True
+    # C4's factor: 1, the flat lattice face's balance n0/(2 d G l0) at re = 2.1 l0 (1.011 in
+    # 3D, 1.016 in 2D); tools/stress_surface_study.py --c4-factor sets another
+    surface_factor = 1.0
 
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
@@ -271,7 +274,7 @@ class StressTension:
     def _surface_pressure(self):
         """C4: P_i = rho l0 max(0, a_i . g_i/|g_i|) for the fluid particles S17/M3 left at
         P = 0 that have a colour gradient (the free surface: omega_i > 0)."""
-        scale = self.coef.rho[None] * self.coef.l0[None]
+        scale = self.surface_factor * self.coef.rho[None] * self.coef.l0[None]
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             g = self.colour[i]
