@@ -3,7 +3,8 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
 
     .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
                           [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
-                          [--sigma-factor S] [--re-ratio X] [--threads N]
+                          [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
+                          [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
 numerics with V1, nu = 1e-5 unless --nu), run P mode-2 periods (default 5). With --kick K the
@@ -12,7 +13,8 @@ K periods, to the drop as it then is: a second start on a liquid that has oscill
 settled, without the first start's melt. --sound-factor S: the drop's sound speed times S;
 --sigma-factor S: sigma times S (water's 0.0728 N/m; the frequency follows sqrt(S), the sound
 speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: re = X l0
-(the case's 2.1). F frames a period (default 40); at each:
+(the case's 2.1); --c4-factor F|lattice: C4's factor F in place of the member's 1, or the
+flat lattice face's balance at the run's re (tools/stress_surface_study.py's option). F frames a period (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
@@ -120,6 +122,8 @@ def main() -> None:
     ap.add_argument("--sound-factor", type=float, default=1.0)
     ap.add_argument("--sigma-factor", type=float, default=1.0)
     ap.add_argument("--re-ratio", type=float, default=None, help="re / l0 (default: the case's)")
+    ap.add_argument("--c4-factor", default=None, metavar="F|lattice",
+                    help="C4's factor (the member's 1), or 'lattice': the face balance at re")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -150,6 +154,13 @@ def main() -> None:
     start_u = scene.vel[scene.kind == FLUID].copy()
     start_x = scene.pos[scene.kind == FLUID]
     G0 = np.linalg.lstsq(start_x - start_x.mean(axis=0), start_u, rcond=None)[0].T
+    if a.c4_factor is not None:
+        import crowndemo.core.surface_tension as family
+        from stress_surface_study import c4_factor_member, face_balance_factor
+        factor = (face_balance_factor(a.dim, scene.physics.re_ratio) if a.c4_factor == "lattice"
+                  else float(a.c4_factor))
+        print(f"C4's factor {factor:.4f}", flush=True)
+        family.MODELS["stress"] = c4_factor_member(family.MODELS["stress"], factor)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1
