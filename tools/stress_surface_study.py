@@ -78,6 +78,9 @@ speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
 ``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
 place of the member's F = 1; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat lattice
 face's balance (face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1 l0);
+``--pair-support H``: C3's pair support H l0 (params.STRESS_PAIR_SUPPORT, the member's 3)
+in place of 3, the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
+and re = 4.0 l0": re + l0 holds the surface at re = 4.0 l0);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
@@ -1145,6 +1148,8 @@ def main() -> None:
                          "viscosity [m^2/s] (default: tension_cases.OSCILLATION_NU, 1e-5)")
     ap.add_argument("--re-ratio", type=float, default=None,
                     help="every drop's re / l0 (the cases' 2.1)")
+    ap.add_argument("--pair-support", type=float, default=None, metavar="H",
+                    help="C3's pair support in l0 (params.STRESS_PAIR_SUPPORT, the member's 3)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
@@ -1176,6 +1181,11 @@ def main() -> None:
     import crowndemo.core.surface_tension as family
     import crowndemo.core.surface_tension.stress as stress
     from crowndemo.core import Numerics
+    if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
+        import crowndemo.core.lattice as lattice_module
+        import crowndemo.core.params as params_module
+        params_module.STRESS_PAIR_SUPPORT = lattice_module.STRESS_PAIR_SUPPORT = \
+            stress.STRESS_PAIR_SUPPORT = a.pair_support
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     dim = (int(a.args[0]) if a.what == "drop" else 3 if a.what == "energy"
