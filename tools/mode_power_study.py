@@ -14,7 +14,8 @@ settled, without the first start's melt. --sound-factor S: the drop's sound spee
 --sigma-factor S: sigma times S (water's 0.0728 N/m; the frequency follows sqrt(S), the sound
 speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: re = X l0
 (the case's 2.1); --c4-factor F|lattice: C4's factor F in place of the member's 1, or the
-flat lattice face's balance at the run's re (tools/stress_surface_study.py's option). F frames a period (default 40); at each:
+flat lattice face's balance at the run's re (tools/stress_surface_study.py's option). F
+frames a period (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
