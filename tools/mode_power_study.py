@@ -157,10 +157,8 @@ def main() -> None:
     G0 = np.linalg.lstsq(start_x - start_x.mean(axis=0), start_u, rcond=None)[0].T
     if a.c4_factor is not None:
         import crowndemo.core.surface_tension as family
-        from stress_surface_study import c4_factor_member, face_balance_factor
-        factor = (face_balance_factor(a.dim, scene.physics.re_ratio) if a.c4_factor == "lattice"
-                  else float(a.c4_factor))
-        print(f"C4's factor {factor:.4f}", flush=True)
+        from stress_surface_study import c4_factor_member, c4_factor_value
+        factor = c4_factor_value(a.c4_factor, a.dim, scene.physics.re_ratio)
         family.MODELS["stress"] = c4_factor_member(family.MODELS["stress"], factor)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)

@@ -230,6 +230,14 @@ def face_balance_factor(dim: int, re_over_l0: float) -> float:
     return float(w.sum()) / (2 * dim * G)
 
 
+def c4_factor_value(arg: str, dim: int, re_over_l0: float) -> float:
+    """``--c4-factor``'s F (printed): a number, or ``lattice``, face_balance_factor at the run's
+    re (this tool's and tools/mode_power_study.py's option)."""
+    factor = face_balance_factor(dim, re_over_l0) if arg == "lattice" else float(arg)
+    print(f"C4's factor {factor:.4f}", flush=True)
+    return factor
+
+
 def c4_factor_member(base, factor: float):
     """``base`` (the member) with C4's pressure F rho l0 max(0, a_i . g_i/|g_i|), F =
     ``factor``, in place of the member's F = 1 (``--c4-factor``; StressTension.surface_factor)."""
@@ -1242,9 +1250,8 @@ def main() -> None:
     if a.c4_factor is not None:
         if a.base != "member" or a.surface is not None:
             raise SystemExit("--c4-factor: --base member without --surface")
-        factor = (face_balance_factor(dim, a.re_ratio or 2.1) if a.c4_factor == "lattice"
-                  else float(a.c4_factor))
-        print(f"C4's factor {factor:.4f}", flush=True)
+        from crowndemo.core import Physics
+        factor = c4_factor_value(a.c4_factor, dim, a.re_ratio or Physics.re_ratio)
         member = c4_factor_member(member, factor)
     family.MODELS["stress"] = member
     if a.relaxed_start > 0.0 and a.what != "energy" and (
