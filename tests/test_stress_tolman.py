@@ -12,11 +12,12 @@ import numpy as np
 import pytest
 
 from crowndemo.core import FLUID, Numerics, Physics, Simulator
-from crowndemo.core.params import STRESS_TOLMAN
+from crowndemo.core.params import STRESS_NEIGHBOURHOODS
 from crowndemo.core.surface_tension.stress import NORMAL_MIN
 
 L0 = 1.0e-4
-DELTA = STRESS_TOLMAN[3]
+SEED_DELTAS = STRESS_NEIGHBOURHOODS[2.1]["tolman"]     # the seed's neighbourhood, re = 2.1 l0
+DELTA = SEED_DELTAS[3]
 
 
 @pytest.fixture(scope="module")
@@ -43,8 +44,8 @@ def passes(sim: Simulator, pos: np.ndarray, times: int = 1):
 
 
 def test_the_correction_is_three_dimensional():
-    """0 in 2D, where the resting drops read sigma/R without it (VALIDATION.md)."""
-    assert STRESS_TOLMAN[2] == 0.0 and 0.5 < STRESS_TOLMAN[3] < 1.5
+    """At re = 2.1 l0: 0 in 2D, where the resting drops read sigma/R without it (VALIDATION.md)."""
+    assert SEED_DELTAS[2] == 0.0 and 0.5 < SEED_DELTAS[3] < 1.5
 
 
 def sphere_points(count: int, r: float) -> np.ndarray:

@@ -247,9 +247,10 @@ def test_info_names_the_model_and_its_constants(capsys):
     assert "delta_l0" not in st["constants"]          # C5 is 3D's
     assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress"]) == 0
     assert "tension     stress: the continuum surface stress" in capsys.readouterr().out
+    assert st["constants"]["F"] == 1.0                 # C4's factor at 2.1 l0
     assert main(["info", "quick", "--set", "numerics.surface_tension=stress"]) == 0
-    from crowndemo.core.params import STRESS_TOLMAN
-    assert f"delta {STRESS_TOLMAN[3]:g} l0" in capsys.readouterr().out
+    from crowndemo.core.params import STRESS_NEIGHBOURHOODS
+    assert f"delta {STRESS_NEIGHBOURHOODS[2.1]['tolman'][3]:g} l0" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("dim", [2, 3])

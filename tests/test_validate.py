@@ -93,8 +93,10 @@ def test_quick_plan_keeps_every_case_with_one_variant():
     # left out of the quick set (cases.QUICK_VARIANT): the crown's two costly ones, the 3D
     # drops' lattice start (a 3D drop's minute for a start the full suite measures) and the
     # oscillating drops' seed viscosity (another model compiled for a variant;
-    # tests/test_viscosity.py holds the member itself)
-    assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=laplacian"}
+    # tests/test_viscosity.py holds the member itself), and the stress drops' wider
+    # neighbourhood (another model; tests/test_stress_neighbourhoods.py runs a 2D drop there)
+    assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=laplacian",
+                            "re=3.1"}
     assert set(cases.QUICK_VARIANT) == set(table) - {"crown-base-3m-drop"}
 
 

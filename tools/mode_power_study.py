@@ -13,9 +13,10 @@ K periods, to the drop as it then is: a second start on a liquid that has oscill
 settled, without the first start's melt. --sound-factor S: the drop's sound speed times S;
 --sigma-factor S: sigma times S (water's 0.0728 N/m; the frequency follows sqrt(S), the sound
 speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: re = X l0
-(the case's 2.1); --c4-factor F|lattice: C4's factor F in place of the member's 1, or the
-flat lattice face's balance at the run's re (tools/stress_surface_study.py's option). F
-frames a period (default 40); at each:
+(the case's 2.1; the member's constants there, params.STRESS_NEIGHBOURHOODS, or F = 1 and
+2.1 l0's delta where it has none); --c4-factor F|lattice: C4's factor F in place of the
+neighbourhood's, or the flat lattice face's balance at the run's re
+(tools/stress_surface_study.py's option). F frames a period (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
@@ -150,6 +151,8 @@ def main() -> None:
                              numerics=numerics, disorder=tc.DISORDER[a.dim], sound_speed=c,
                              sigma=sigma)
     if a.re_ratio is not None:
+        from stress_surface_study import admit_neighbourhood
+        admit_neighbourhood(a.re_ratio)       # an re the member has no constants for: F = 1
         scene = replace(scene, physics=replace(scene.physics, re_ratio=a.re_ratio).validate())
     period, lamb = scene.info["period_s"], scene.info["decay_1_s"]
     start_u = scene.vel[scene.kind == FLUID].copy()

@@ -66,18 +66,22 @@ M_i = sum_j r_t^2 f_d over every neighbour (the tension virial's own), M0 a flat
 (|g_i| + |g_j|) (or, with ``--membrane-ref G``, min(1, |g_i| l0/G) min(1, |g_j| l0/G)), so
 the tension acts between surface particles only (an inner particle, g = 0, takes none of the
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
-``--tolman DELTA``: C5's delta (stress.py; params.STRESS_TOLMAN) for the run's dimension, 0
-for the member before C5 (``--base first`` runs without C5 unless given); ``--tolman-pass
-DELTA``: the study that led to C5 (C5 off): s_i from this step's normals in a third pass
-between pass 1 and pass 2 (tolman_member), with ``--tolman-fit`` H_i from the curvature
-member's surface fit instead of the normals' divergence (tolman_fit_member).
+``--tolman DELTA``: C5's delta (StressTension.tolman_delta) in place of the neighbourhood's
+(params.STRESS_NEIGHBOURHOODS), 0 for the member before C5 (``--base first`` runs without C5
+unless given); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
+step's normals in a third pass between pass 1 and pass 2 (tolman_member), with
+``--tolman-fit`` H_i from the curvature member's surface fit instead of the normals'
+divergence (tolman_fit_member).
 ``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``,
 ``energy``; tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound
 speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
-``--re-ratio X``: every drop's re = X l0 (the cases' 2.1; tools/mode_power_study.py);
+``--re-ratio X``: every drop's re = X l0 (the cases' 2.1; tools/mode_power_study.py), with
+the member's constants there (params.STRESS_NEIGHBOURHOODS: since 2026-12-07 at 3.1 l0 F from
+the lattice and delta 0.9 in 2D, so the 3.1 l0 rows before, with F = 1, take ``--c4-factor 1``
+and in 2D ``--tolman 0``), elsewhere the seed neighbourhood's (admit_neighbourhood);
 ``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
-place of the member's F = 1; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat lattice
-face's balance (face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1 l0);
+place of the neighbourhood's F; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat
+lattice face's balance (face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1 l0);
 ``--pair-support H``: C3's pair support H l0 (params.STRESS_PAIR_SUPPORT, the member's 3)
 in place of 3, the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
 and re = 4.0 l0": re + l0 holds the surface at re = 4.0 l0);
@@ -218,16 +222,28 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
 
 
 def face_balance_factor(dim: int, re_over_l0: float) -> float:
-    """C4's factor F = n0 / (2 d G l0) at which the sum form's push of a uniform pressure on a
-    flat lattice face's particle, 2 d P G / n0 (G the half-lattice's sum of r_z w / r^2),
-    equals its own pull (stress.py C4): 1.016 / 1.011 (2D / 3D) at re = 2.1 l0, the member's 1;
-    1.160 / 1.187 at 3.1 l0 (VALIDATION.md "re = 3.1 l0 with C4's factor from the lattice")."""
-    from crowndemo.core.lattice import lattice_offsets, weight
-    q = lattice_offsets(dim, 1.0, re_over_l0)
-    w = weight(np.linalg.norm(q, axis=1), re_over_l0)
-    below = q[:, -1] < 0
-    G = -float((q[below, -1] * w[below] / (q[below] ** 2).sum(axis=1)).sum())
-    return float(w.sum()) / (2 * dim * G)
+    """C4's factor from the lattice (lattice.face_balance_factor, the member's at 3.1 l0)."""
+    from crowndemo.core.lattice import face_balance_factor as lattice_factor
+    return lattice_factor(dim, re_over_l0)
+
+
+def admit_neighbourhood(re_over_l0: float) -> None:
+    """Lets the study run the stress member at an re it has no constants for
+    (params.STRESS_NEIGHBOURHOODS refuses it): with the seed neighbourhood's, F = 1 and 2.1
+    l0's deltas, unless --c4-factor / --tolman set others (how the study ran re = 4.0 l0)."""
+    import crowndemo.core.params as params
+    try:
+        params.stress_neighbourhood(re_over_l0)
+    except params.ParameterError:
+        seed = params.STRESS_NEIGHBOURHOODS[2.1]
+        params.STRESS_NEIGHBOURHOODS[re_over_l0] = {"c4_factor": 1.0,
+                                                    "tolman": dict(seed["tolman"])}
+
+
+def tolman_delta_member(base, delta: float):
+    """``base`` with C5's delta ``delta`` (l0) in place of its neighbourhood's (``--tolman``;
+    StressTension.tolman_delta, read at __init__; 0 compiles C5 out)."""
+    return ti.data_oriented(type("TolmanDeltaStress", (base,), {"tolman_delta": float(delta)}))
 
 
 def c4_factor_value(arg: str, dim: int, re_over_l0: float) -> float:
@@ -240,8 +256,8 @@ def c4_factor_value(arg: str, dim: int, re_over_l0: float) -> float:
 
 def c4_factor_member(base, factor: float):
     """``base`` (the member) with C4's pressure F rho l0 max(0, a_i . g_i/|g_i|), F =
-    ``factor``, in place of the member's F = 1 (``--c4-factor``; StressTension.surface_factor)."""
-    return ti.data_oriented(type("C4FactorStress", (base,), {"surface_factor": float(factor)}))
+    ``factor``, in place of its neighbourhood's (``--c4-factor``; StressTension.c4_factor)."""
+    return ti.data_oriented(type("C4FactorStress", (base,), {"c4_factor": float(factor)}))
 
 
 def eos_pressure_member(base, slope: float):
@@ -1241,8 +1257,10 @@ def main() -> None:
         from crowndemo.core import pressure
         pressure.gradient_pair = dn_gradient(dim)
 
+    if a.re_ratio is not None:
+        admit_neighbourhood(a.re_ratio)
     if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
-        stress.STRESS_TOLMAN[dim] = 0.0 if a.tolman is None else a.tolman   # read at __init__
+        member = tolman_delta_member(member, 0.0 if a.tolman is None else a.tolman)
     if a.tolman_pass is not None:
         if a.tolman is not None:
             raise SystemExit("--tolman-pass: not with --tolman")

@@ -7,7 +7,7 @@ import shlex
 from typing import Dict
 
 from .. import strictjson
-from ..core.params import SOUND_SPEED_FACTOR, STRESS_TOLMAN, VISCOUS_STIFFNESS
+from ..core.params import SOUND_SPEED_FACTOR, VISCOUS_STIFFNESS
 from .common import load_preset
 
 
@@ -20,13 +20,16 @@ SURFACE_TENSION_WHAT = {
 
 def surface_tension_summary(model: str, lat, sigma: float) -> dict:
     """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3;
-    C5's delta in 3D)."""
+    the neighbourhood's C4 factor F and C5's delta where it is not 0)."""
     if model == "potential":
         constants = {"C": lat.C}
     elif model == "stress":
-        constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd}
-        if STRESS_TOLMAN[lat.dim] > 0:      # C5's curvature correction (3D)
-            constants["delta_l0"] = STRESS_TOLMAN[lat.dim]
+        from ..core.lattice import stress_constants
+        factor, delta = stress_constants(lat.dim, lat.re / lat.l0)
+        constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd,
+                     "F": factor}
+        if delta > 0:      # C5's curvature correction (3D; 2D at 3.1 l0)
+            constants["delta_l0"] = delta
     else:
         constants = {}
     return {"model": model, "what": SURFACE_TENSION_WHAT[model], "sigma_N_m": sigma,
@@ -114,6 +117,19 @@ def _model_cost(r, cost: dict) -> str:
         return ""
     return (f", the {r.model.surface_tension_model} model's passes included "
             f"({cost['surface_tension_model']:g} x the potential's)")
+
+
+def _neighbourhood_cost(r) -> str:
+    """'; ...' where re is not the seed's 2.1 l0, at which every cost of the estimate was
+    measured: a wider neighbourhood walks more pairs (the lattice's count within re)."""
+    from ..core.lattice import lattice_offsets
+    re_ratio = r.physics.re_ratio
+    if abs(re_ratio - 2.1) < 1e-9:
+        return ""
+    seed, own = (len(lattice_offsets(r.dim, 1.0, x)) for x in (2.1, re_ratio))
+    return (f"; the costs are measured at re = 2.1 l0, where a particle has {seed} lattice "
+            f"neighbours against {own} at {re_ratio:g} l0, so this run takes "
+            f"{'longer' if own > seed else 'less'}")
 
 
 def _speed_in_c(v: float, c: float, U: float) -> str:
@@ -240,7 +256,7 @@ def info_preset(args) -> int:
           f"{cost['before_contact']:.3g} of it a fluid particle before contact and "
           f"{cost['after_contact']:.3g} after{_model_cost(r, cost)} (a wall or dummy particle "
           f"{cost['wall_or_dummy']:g} of a fluid one), + {f['compile_seconds']:g} s compiling "
-          f"(a first run; 3-9 s with the kernels in Taichi's cache)")
+          f"(a first run; 3-9 s with the kernels in Taichi's cache){_neighbourhood_cost(r)}")
     left = f["left_out"] or ["nothing"]
     for i, line in enumerate(left):
         print(f"  {'left out' if i == 0 else '':<11} {'- ' if f['left_out'] else ''}{line}")

@@ -31,9 +31,9 @@ Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-la
 stress-laplace, stress-drop-oscillation, stress-free-drop (each -2d and -3d),
 crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. The stress- cases run the
 surface-stress model (method.md §4c) with the sum gradient form, their 3D drops started off
-the lattice (variant lattice: on it). Each case runs
-at three resolutions in the base settings and, at the middle one, in its settings variants
-(--list says which case runs which):
+the lattice (variant lattice: on it), at re = 2.1 l0 (variant re=3.1: the member's wider
+neighbourhood). Each case runs at three resolutions in the base settings and, at the middle
+one, in its settings variants (--list says which case runs which):
   {variants}
 --quick runs each case at one coarse resolution and in one of its variants (--list names
 it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop, stress-free-drop-3d and

@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import STRESS_PAIR_SUPPORT, ParameterError
+from .params import STRESS_NEIGHBOURHOODS, STRESS_PAIR_SUPPORT, ParameterError, \
+    stress_neighbourhood
 
 # l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
 # user's spacing is checked against its command's own, narrower range first (cli/info_lattice.py)
@@ -147,6 +148,29 @@ def stress_normaliser(dim: int, l0: float, re: float) -> float:
                 gj = g[kj] if kj <= m else 0.0
                 total += off[0] ** 2 * ff * (g[k] + gj)
     return 1.0 / (l0 * K * total)
+
+
+def face_balance_factor(dim: int, re_ratio: float) -> float:
+    """F = n0 / (2 d G l0), G the lattice half-space's sum of -r_z w / r^2 over the offsets
+    below a face particle (S11's pair term): the factor at which the sum form's push of a
+    uniform pressure P on a flat lattice face's particle, 2 d P G / n0, equals the pull rho
+    l0 F a_i.g_i/|g_i| that C4 sets its pressure from (method.md §4c). 1.016 / 1.011 (2D /
+    3D) at 2.1 l0, 1.160 / 1.187 at 3.1 l0. Dimensionless."""
+    q = lattice_offsets(dim, 1.0, re_ratio)
+    w = weight(np.linalg.norm(q, axis=1), re_ratio)
+    below = q[:, -1] < 0
+    G = -float((q[below, -1] * w[below] / (q[below] ** 2).sum(axis=1)).sum())
+    return float(w.sum()) / (2 * dim * G)
+
+
+def stress_constants(dim: int, re_ratio: float) -> tuple[float, float]:
+    """The stress member's (C4's F, C5's delta in l0) at ``re_ratio``
+    (params.STRESS_NEIGHBOURHOODS; a ParameterError for a neighbourhood it has none for)."""
+    own = STRESS_NEIGHBOURHOODS[stress_neighbourhood(re_ratio)]
+    factor = own["c4_factor"]
+    if factor == "lattice":
+        factor = face_balance_factor(dim, re_ratio)
+    return float(factor), float(own["tolman"][dim])
 
 
 @dataclass(frozen=True)

@@ -27,12 +27,32 @@ VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 # the surface stress's divergence pair kernel reaches STRESS_PAIR_SUPPORT l0 (method.md C3):
 # beyond re = 2.1 l0, so its walk is the grid's wide one (grid.py)
 STRESS_PAIR_SUPPORT = 3.0
-# the surface stress's curvature correction sigma (1 - delta H) (method.md C5): delta, per
-# dimension, in l0; the surface of tension sits inside the liquid's surface in 3D drops
-# (VALIDATION.md, "The curvature correction"); 0 compiles it out. 0.80 in 3D: the value at
-# which the resting drop's error falls with resolution (VALIDATION.md, "C5's H from the
-# normals' tangential change"; 0.92, set at R/l0 = 12 alone, over-corrected at 16)
-STRESS_TOLMAN = {2: 0.0, 3: 0.80}
+# the surface stress's neighbourhoods (method.md §4c), re/l0 -> its measured constants:
+# - "c4_factor": C4's F, the free surface's own normal stress F rho l0 a.g/|g|; "lattice": the
+#   flat lattice face's balance n0/(2 d G l0) at that re (lattice.face_balance_factor: 1.160 /
+#   1.187 in 2D / 3D at 3.1 l0); 1 at 2.1 l0, where the balance is 1.016 / 1.011;
+# - "tolman": C5's curvature correction sigma (1 - delta H), delta in l0 per dimension; the
+#   surface of tension sits inside the liquid's surface (VALIDATION.md, "The curvature
+#   correction"); 0 compiles it out. 0.80 in 3D: the value at which the resting drop's error
+#   falls with resolution (VALIDATION.md, "C5's H from the normals' tangential change"; 0.92,
+#   set at R/l0 = 12 alone, over-corrected at 16); 0.9 in 2D at 3.1 l0, where without it the
+#   drop read high ("re = 3.1 l0 completed").
+# 2.1 l0 is the seed's neighbourhood, the crowns'; at 3.1 l0 the 3D drops' Laplace and mode-2
+# errors fall with resolution and the decay's excess over Lamb's rate is halved (a 3D
+# particle has 122 lattice neighbours within re against 32; the 3D drop cases ran 1.8-2.2
+# times as long). The constants are measured, not derived: another re is refused.
+STRESS_NEIGHBOURHOODS = {2.1: {"c4_factor": 1.0, "tolman": {2: 0.0, 3: 0.80}},
+                         3.1: {"c4_factor": "lattice", "tolman": {2: 0.9, 3: 0.80}}}
+
+
+def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
+    """The key of STRESS_NEIGHBOURHOODS that ``re_ratio`` is (within 1e-9), or a
+    ParameterError naming re_ratio and the calibrated values."""
+    for key in STRESS_NEIGHBOURHOODS:
+        if _finite(re_ratio) and abs(re_ratio - key) < 1e-9:
+            return key
+    raise ParameterError("re_ratio", re_ratio, " or ".join(f"{k:g}" for k in STRESS_NEIGHBOURHOODS)
+                         + " with surface_tension: stress", source)
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
@@ -188,18 +208,24 @@ class Model:
     surface_tension_model: str = "potential"   # the family member (core/surface_tension/)
     wide_walk: float = 1.0           # the grid's wide walk over re (grid.py; stress C3)
     viscosity_model: str = "laplacian"   # the family member (core/viscosity.py)
+    # re/l0 whose constants the stress member compiles in (STRESS_NEIGHBOURHOODS); the seed's
+    # 2.1 for the other members, so a simulator of theirs serves any re (control.Session)
+    stress_re_ratio: float = 2.1
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
+        """What ``physics`` and ``numerics`` compile in; a ParameterError (re_ratio) where the
+        stress member is chosen at a neighbourhood it has no constants for."""
+        stress = physics.sigma > 0 and numerics.surface_tension == "stress"
         return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
                    numerics.cells_per_re, numerics.wall_model == "plane",
                    numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
                    numerics.predictor_list and numerics.neighbour_list,
                    numerics.surface_tension,
-                   max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio)
-                   if physics.sigma > 0 and numerics.surface_tension == "stress" else 1.0,
-                   numerics.viscosity)
+                   max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio) if stress else 1.0,
+                   numerics.viscosity,
+                   stress_neighbourhood(physics.re_ratio) if stress else 2.1)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,

@@ -56,12 +56,13 @@ def drop_sound_speed(l0: float, sigma: float, rho: float) -> float:
 def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
                      amplitude: float = 0.1, periods: float = 2.0,
                      numerics: Optional[Numerics] = None, sound_speed: Optional[float] = None,
-                     disorder: float = 0.0, **liquid) -> Scene:
+                     disorder: float = 0.0, re_ratio: float = 2.1, **liquid) -> Scene:
     """A disc (ball) of radius R released with the velocity of its mode-2 oscillation of
     relative amplitude ``amplitude``: the potential phi = A (x^2 - y^2) in 2D,
     A (z^2 - (x^2 + y^2)/2) in 3D, with A = amplitude omega / 2, so that the surface moves as
     R (1 + amplitude cos(2 theta) sin(omega t)) (P2 in 3D). Runs ``periods`` periods. The
-    particles sit on the lattice, or with ``disorder`` > 0 off it (``disordered``)."""
+    particles sit on the lattice, or with ``disorder`` > 0 off it (``disordered``); re =
+    ``re_ratio`` l0 (S10)."""
     liq = {**WATER, **liquid}
     omega = mode2_omega(dim, radius, liq["sigma"], liq["rho"])
     A = 0.5 * amplitude * omega
@@ -73,7 +74,7 @@ def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
         vel[:, 0], vel[:, 1], vel[:, 2] = -A * pts[:, 0], -A * pts[:, 1], 2 * A * pts[:, 2]
     c = sound_speed or drop_sound_speed(l0, liq["sigma"], liq["rho"])
     physics = Physics(dim=dim, l0=l0, v_max=max(2 * A * radius, 1e-3), gravity=0.0,
-                      sound_speed=c, **liq)
+                      sound_speed=c, re_ratio=re_ratio, **liq)
     period = 2 * math.pi / omega
     domain = (tuple([-4.0 * radius] * dim), tuple([4.0 * radius] * dim))
     info = {"scene": "oscillating drop", "radius_m": radius, "amplitude": amplitude,
@@ -94,10 +95,12 @@ def oscillating_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4,
 
 def resting_drop(dim: int = 2, radius: float = 1.0e-3, l0: float = 1.0e-4, t_end: float = 0.01,
                  numerics: Optional[Numerics] = None, sound_speed: Optional[float] = None,
-                 disorder: float = 0.0, **liquid) -> Scene:
+                 disorder: float = 0.0, re_ratio: float = 2.1, **liquid) -> Scene:
     """A disc (ball) of radius R at rest without gravity: its inside pressure exceeds the
-    outside by sigma/R (2D), 2 sigma/R (3D). ``disorder``: as ``oscillating_drop``'s."""
+    outside by sigma/R (2D), 2 sigma/R (3D). ``disorder``, ``re_ratio``: as
+    ``oscillating_drop``'s."""
     sc = oscillating_drop(dim, radius, l0, amplitude=0.0, numerics=numerics,
-                          sound_speed=sound_speed, disorder=disorder, **liquid)
+                          sound_speed=sound_speed, disorder=disorder, re_ratio=re_ratio,
+                          **liquid)
     sc.info["scene"] = "resting drop"
     return replace(sc, name="resting-drop", t_end=t_end)

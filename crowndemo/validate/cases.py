@@ -347,9 +347,10 @@ def crown_case(preset: str = "quick", t_end: Optional[float] = None,
 # which kept a first `--quick` (an empty Taichi cache) past 5 minutes (issue 26). Not in the
 # quick set: the crown's untrimmed film (11 times the particles) and its Courant limit on
 # relative speeds (another 3D model; the stability suite's -relative cases run it in 2D), and
-# the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it), and
-# the oscillating drops' viscosity=laplacian (another model; tests/test_viscosity.py holds
-# the member).
+# the 3D stress drops' lattice start (another minute of 3D drop; the full suite runs it), the
+# oscillating drops' viscosity=laplacian (another model; tests/test_viscosity.py holds
+# the member), and the stress drops' re=3.1 (another model; tests/test_stress_neighbourhoods.py
+# runs the 2D resting drop there).
 QUICK_VARIANT = {"hydrostatic-2d": "plane-floor", "hydrostatic-3d": "safety/2",
                  "dam-break-2d": "gradient=sum", "dam-break-3d": "safety/2",
                  "drop-oscillation-2d": "gradient=seed", "drop-oscillation-3d": "safety/2",
@@ -382,7 +383,9 @@ def all_cases(full: bool = True) -> Dict[str, Case]:
 def variant_scene(variant: str) -> Dict[str, object]:
     """The keyword arguments a settings variant passes to its case's run (its scene): the
     crown's film not trimmed (``untrimmed``), the surface-stress drops on the lattice
-    (``lattice``; tension_cases.DISORDER)."""
+    (``lattice``; tension_cases.DISORDER) or at re = X l0 (``re=X``; tension_cases.WIDE)."""
+    if variant.startswith("re="):      # another neighbourhood re/l0 (the stress drops)
+        return {"re_ratio": float(variant.split("=", 1)[1])}
     return {"untrimmed": {"trim": False}, "lattice": {"disorder": 0.0}}.get(variant, {})
 
 

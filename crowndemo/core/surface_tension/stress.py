@@ -41,13 +41,14 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    potential (S22, r < l0) and Monaghan's (2000) cure for the tensile instability;
 3. the free surface's pressure (C4): a fluid particle that S17/M3 left at P = 0 and that has a
    colour gradient takes the normal stress its own tension carries,
-   P_i = rho l0 max(0, a_i . g_i/|g_i|),
+   P_i = F rho l0 max(0, a_i . g_i/|g_i|),
    the force a_i pulls it in with, over the area l0^(d-1) it holds. With P = 0 on the surface
    only the liquid a spacing inside carried the inside pressure (60-83 % of a 3D drop's volume
    at R/l0 = 8-16, the virial, VALIDATION.md), and the first member's 3D drops read 42-59 %
-   high; with C4 the surface layer carries it. The factor 1 is the flat lattice face's
-   balance: the sum form's push of a uniform pressure on a face particle, 2 P G/n0 d, equals
-   its own pull at F = n0/(2 d G) = 1.016 (2D) / 1.011 (3D). It needs no pass: a_i is pass 2's;
+   high; with C4 the surface layer carries it. F is the flat lattice face's balance: the sum
+   form's push of a uniform pressure on a face particle, 2 P G/n0 d, equals its own pull at
+   F = n0/(2 d G) (lattice.face_balance_factor): 1.016 (2D) / 1.011 (3D) at 2.1 l0, where the
+   member takes 1; 1.160 / 1.187 at 3.1 l0. It needs no pass: a_i is pass 2's;
 4. the curvature correction (C5): particle i's tension T_i is taken s_i = clamp(1 - delta l0
    H_i, 1/2, 3/2) times, H_i the mean curvature from the tangential divergence of the unit
    normals n = g/|g| over its neighbours within re, H_i = -sum_j n_j . r_t f / sum_j |r_t|^2 f
@@ -58,15 +59,18 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    drop the pull lands about a spacing inside the liquid's surface and the inside pressure
    read 2 sigma/(R - 0.9 l0) (+17 / +8 / +5 % at R/l0 = 8 / 12 / 16), and the mode-2
    frequency as high: a surface of tension delta inside the liquid's, as Tolman's (1949) for a
-   real liquid, sigma (1 - delta H) moving it back out. delta = params.STRESS_TOLMAN (l0): 0.80
-   in 3D, where the resting drop's error falls with resolution (+4.1 / +0.5 / -0.2 % at
-   R/l0 = 8 / 12 / 16; the error without C5 times 1 - delta/(R/l0 - 0.6); 0.92, which
-   cancelled the +8.27 % at 12 alone, over-corrected at 16); 0 in 2D (compiled out), whose drops read
-   +4 / +2 / 0 % without it. H_i is summed in pass 2's walk and used in the next step's pass 2
-   (s_i lags a step, a carried field, so no third pass); the pairs stay antisymmetric, as
-   (s_i T_i + s_j T_j) r_ij f_d.
+   real liquid, sigma (1 - delta H) moving it back out. delta (l0): 0.80 in 3D, where the
+   resting drop's error falls with resolution (+4.1 / +0.5 / -0.2 % at R/l0 = 8 / 12 / 16;
+   the error without C5 times 1 - delta/(R/l0 - 0.6); 0.92, which cancelled the +8.27 % at
+   12 alone, over-corrected at 16); in 2D 0 at 2.1 l0 (compiled out), whose drops read
+   +4 / +2 / 0 % without it, and 0.9 at 3.1 l0. H_i is summed in pass 2's walk and used in
+   the next step's pass 2 (s_i lags a step, a carried field, so no third pass); the pairs
+   stay antisymmetric, as (s_i T_i + s_j T_j) r_ij f_d.
 
-The acceleration is applied in the corrector with the pressure gradient (S18-S20), at r*.
+F and delta are the neighbourhood's (params.STRESS_NEIGHBOURHOODS: re = 2.1 l0, the seed's, or
+3.1 l0, where the 3D drops' errors fall with resolution; another re is refused, its constants
+unmeasured). The acceleration is applied in the corrector with the pressure gradient
+(S18-S20), at r*.
 ``_pair_weight`` and ``_surface_pressure`` are the member's two choices (C3's f_d, C4), each a
 method, so a study (tools/stress_surface_study.py) can swap one without restating a pass.
 Only fluid particles carry tension; with symmetry planes, images carry their sources' mirrored
@@ -76,7 +80,8 @@ import taichi as ti
 
 from ..coefficients import Coefficients
 from ..grid import CellGrid
-from ..params import STRESS_PAIR_SUPPORT, STRESS_TOLMAN, Model
+from ..lattice import stress_constants
+from ..params import STRESS_PAIR_SUPPORT, Model
 from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
@@ -142,9 +147,12 @@ class StressTension:
     name = "stress"
     pair_term = False          # acts in the corrector (``corrector_term``), not the predictor
     corrector_term = True
-    # C4's factor: 1, the flat lattice face's balance n0/(2 d G l0) at re = 2.1 l0 (1.011 in
-    # 3D, 1.016 in 2D); tools/stress_surface_study.py --c4-factor sets another
-    surface_factor = 1.0
+    # C4's factor F and C5's delta (l0): None takes the neighbourhood's own
+    # (params.STRESS_NEIGHBOURHOODS, lattice.stress_constants: at 2.1 l0 F = 1, the flat
+    # lattice face's balance n0/(2 d G l0) rounded, 1.011 in 3D); a study sets another
+    # (tools/stress_surface_study.py --c4-factor, --tolman)
+    c4_factor = None
+    tolman_delta = None
 
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
@@ -153,8 +161,10 @@ class StressTension:
         self.colour = ti.Vector.field(self.dim, float, cap)   # g_i (C1) [1/m]
         self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
         self.floor = None        # the analytic plane floor, where the model has one
-        # C5: sigma (1 - delta H), delta in l0 (params.STRESS_TOLMAN); s_i lags one step
-        self.delta = STRESS_TOLMAN[self.dim]
+        factor, delta = stress_constants(self.dim, model.stress_re_ratio)
+        self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
+        # C5: sigma (1 - delta H), delta in l0; s_i lags one step
+        self.delta = delta if self.tolman_delta is None else float(self.tolman_delta)
         self.tolman = self.tolman_next = None
         if self.delta > 0.0:
             self.tolman = self.state.carry("stress_tolman", ti.field(float, cap), 1.0)   # s_i
