@@ -124,7 +124,8 @@ SCENE_KEYS = {
     "frame_interval": number("time between recorded frames", "s", 0, 10),
     "trim": Field("bool", "leave out the film and walls the impact cannot reach by t_end",
                   default=True),
-    "re_ratio": number("influence radius re / l0", "", 1.5, 4.5, lo_incl=True, default=2.1),
+    "re_ratio": number("influence radius re / l0 (with the stress model 2.1 or 3.1)", "", 1.5,
+                       4.5, lo_incl=True, default=2.1),
     "trim_reach": number("with trim: the film kept reaches this many times Yarin & Weiss's "
                          "crown base radius at t_end (at least D), + 2 mm", "", 1, 10,
                          lo_incl=True, default=2.0),
