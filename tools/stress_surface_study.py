@@ -1206,10 +1206,8 @@ def main() -> None:
     import crowndemo.core.surface_tension.stress as stress
     from crowndemo.core import Numerics
     if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
-        import crowndemo.core.lattice as lattice_module
         import crowndemo.core.params as params_module
-        params_module.STRESS_PAIR_SUPPORT = lattice_module.STRESS_PAIR_SUPPORT = \
-            stress.STRESS_PAIR_SUPPORT = a.pair_support
+        params_module.STRESS_PAIR_SUPPORT = a.pair_support
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     dim = (int(a.args[0]) if a.what == "drop" else 3 if a.what == "energy"

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .params import STRESS_NEIGHBOURHOODS, STRESS_PAIR_SUPPORT, ParameterError, \
-    stress_neighbourhood
+from . import params
+from .params import STRESS_NEIGHBOURHOODS, ParameterError, stress_neighbourhood
 
 # l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
 # user's spacing is checked against its command's own, narrower range first (cli/info_lattice.py)
@@ -86,8 +86,9 @@ def stress_kernel(r: np.ndarray, re: float) -> np.ndarray:
 
 
 def stress_pair_support(l0: float) -> float:
-    """H = STRESS_PAIR_SUPPORT l0 = 3 l0: the support of the divergence's pair weight (C3)."""
-    return STRESS_PAIR_SUPPORT * l0
+    """H = params.STRESS_PAIR_SUPPORT l0 = 3 l0: the support of the divergence's pair weight
+    (C3); read at each call, so a study that sets the one constant moves every reader."""
+    return params.STRESS_PAIR_SUPPORT * l0
 
 
 def stress_pair_kernel(r: np.ndarray, h: float) -> np.ndarray:

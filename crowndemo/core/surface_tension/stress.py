@@ -80,8 +80,9 @@ import taichi as ti
 
 from ..coefficients import Coefficients
 from ..grid import CellGrid
+from .. import params
 from ..lattice import stress_constants
-from ..params import STRESS_PAIR_SUPPORT, Model
+from ..params import Model
 from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
@@ -230,7 +231,7 @@ class StressTension:
     def _pair_weight(self, r):
         """f_d(r) with its core (C3)."""
         l0 = self.coef.l0[None]
-        return stress_pair_kernel(r, STRESS_PAIR_SUPPORT * l0, l0)
+        return stress_pair_kernel(r, params.STRESS_PAIR_SUPPORT * l0, l0)   # H (compile time)
 
     @ti.func
     def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -262,7 +263,7 @@ class StressTension:
         g g^T/|g|) (C2), T_j = 0 for walls and dummies (the plane floor's layers: d_floor)."""
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
-        reach2 = (STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2      # H^2: the wide walk
+        reach2 = (params.STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2    # H^2: the wide walk
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             s_next = 1.0
