@@ -109,16 +109,12 @@ def test_viscous_terms_are_the_predictors(dim, viscosity):
     np.testing.assert_allclose(numpy_sum, kernel, rtol=rtol, atol=rtol * np.abs(kernel).max())
 
 
-def test_face_balance_factor_of_the_study_tool():
-    """tools/stress_surface_study.face_balance_factor: C4's factor n0 / (2 d G l0) from the
-    lattice sums, the value above at re = 2.1 l0, and larger in a wider neighbourhood, where the
-    half-lattice's push G grows slower than n0 (the lattice sums written out at 3.1 l0 in 2D:
-    n0 = 18.9764, G = 4.0898)."""
-    from pathlib import Path
-    path = Path(__file__).resolve().parents[1] / "tools" / "stress_surface_study.py"
-    spec = importlib.util.spec_from_file_location("stress_surface_study", path)
-    study = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(study)
-    assert study.face_balance_factor(2, 2.1) == pytest.approx(1.016, abs=1e-3)
-    assert study.face_balance_factor(3, 2.1) == pytest.approx(1.011, abs=1e-3)
-    assert study.face_balance_factor(2, 3.1) == pytest.approx(18.9764 / (4 * 4.0898), rel=1e-4)
+def test_face_balance_factor_of_the_study_tools():
+    """lattice.face_balance_factor, the study tools' ``--c4-factor lattice``: C4's factor
+    n0 / (2 d G l0) from the lattice sums, the value above at re = 2.1 l0, and larger in a wider
+    neighbourhood, where the half-lattice's push G grows slower than n0 (the lattice sums
+    written out at 3.1 l0 in 2D: n0 = 18.9764, G = 4.0898)."""
+    from crowndemo.core.lattice import face_balance_factor
+    assert face_balance_factor(2, 2.1) == pytest.approx(1.016, abs=1e-3)
+    assert face_balance_factor(3, 2.1) == pytest.approx(1.011, abs=1e-3)
+    assert face_balance_factor(2, 3.1) == pytest.approx(18.9764 / (4 * 4.0898), rel=1e-4)

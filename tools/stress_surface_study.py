@@ -81,7 +81,8 @@ the lattice and delta 0.9 in 2D, so the 3.1 l0 rows before, with F = 1, take ``-
 and in 2D ``--tolman 0``), elsewhere the seed neighbourhood's (admit_neighbourhood);
 ``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
 place of the neighbourhood's F; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat
-lattice face's balance (face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1 l0);
+lattice face's balance (lattice.face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1
+l0);
 ``--pair-support H``: C3's pair support H l0 (params.STRESS_PAIR_SUPPORT, the member's 3)
 in place of 3, the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
 and re = 4.0 l0": re + l0 holds the surface at re = 4.0 l0);
@@ -221,12 +222,6 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
     return OwnPressureStress
 
 
-def face_balance_factor(dim: int, re_over_l0: float) -> float:
-    """C4's factor from the lattice (lattice.face_balance_factor, the member's at 3.1 l0)."""
-    from crowndemo.core.lattice import face_balance_factor as lattice_factor
-    return lattice_factor(dim, re_over_l0)
-
-
 def admit_neighbourhood(re_over_l0: float) -> None:
     """Lets the study run the stress member at an re it has no constants for
     (params.STRESS_NEIGHBOURHOODS refuses it): with the seed neighbourhood's, F = 1 and 2.1
@@ -247,8 +242,9 @@ def tolman_delta_member(base, delta: float):
 
 
 def c4_factor_value(arg: str, dim: int, re_over_l0: float) -> float:
-    """``--c4-factor``'s F (printed): a number, or ``lattice``, face_balance_factor at the run's
-    re (this tool's and tools/mode_power_study.py's option)."""
+    """``--c4-factor``'s F (printed): a number, or ``lattice``, lattice.face_balance_factor at
+    the run's re (this tool's and tools/mode_power_study.py's option)."""
+    from crowndemo.core.lattice import face_balance_factor
     factor = face_balance_factor(dim, re_over_l0) if arg == "lattice" else float(arg)
     print(f"C4's factor {factor:.4f}", flush=True)
     return factor
@@ -1146,7 +1142,8 @@ def main() -> None:
     ap.add_argument("--own-factor", type=float, default=1.0)
     ap.add_argument("--c4-factor", default=None,
                     help="--base member: C4's factor F (a number, or 'lattice': n0/(2 d G l0) "
-                         "at the run's re, face_balance_factor); default the member's 1")
+                         "at the run's re, lattice.face_balance_factor); default the "
+                         "neighbourhood's")
     ap.add_argument("--own-per-area", action="store_true")
     ap.add_argument("--theta-slope", type=float, default=None,
                     help="--surface eos: C in theta = 1 - C |g| l0 (default 0.72 2D, 0.62 3D)")

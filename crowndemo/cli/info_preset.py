@@ -123,12 +123,13 @@ def _neighbourhood_cost(r) -> str:
     """'; ...' where re is not the seed's 2.1 l0, at which every cost of the estimate was
     measured: a wider neighbourhood walks more pairs (the lattice's count within re)."""
     from ..core.lattice import lattice_offsets
-    re_ratio = r.physics.re_ratio
-    if abs(re_ratio - 2.1) < 1e-9:
+    from ..core.params import Physics
+    re_ratio, seed_ratio = r.physics.re_ratio, Physics.re_ratio
+    if abs(re_ratio - seed_ratio) < 1e-9:
         return ""
-    seed, own = (len(lattice_offsets(r.dim, 1.0, x)) for x in (2.1, re_ratio))
-    return (f"; the costs are measured at re = 2.1 l0, where a particle has {seed} lattice "
-            f"neighbours against {own} at {re_ratio:g} l0, so this run takes "
+    seed, own = (len(lattice_offsets(r.dim, 1.0, x)) for x in (seed_ratio, re_ratio))
+    return (f"; the costs are measured at re = {seed_ratio:g} l0, where a particle has {seed} "
+            f"lattice neighbours against {own} at {re_ratio:g} l0, so this run takes "
             f"{'longer' if own > seed else 'less'}")
 
 

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Dict, List, Optional, Tuple
 
 from ..core import timestep
 from ..core.health import starts_too_fast
-from ..core.params import Model, Numerics, ParameterError, Physics, stress_neighbourhood
+from ..core.params import Model, Numerics, ParameterError, Physics
 from .errors import MISSING, PresetError
 from .loader import Document
 from .merge import DEFAULT_SOURCE
@@ -262,13 +262,11 @@ def resolve(doc: Document, quality: str) -> Resolved:
             fail(physics_keys[e.key], e.value, "refused by the solver", e.allowed)
         raise PresetError(doc.label, f"scene.liquid.{e.key}", e.value, "refused by the solver",
                           e.allowed) from None
-    if numerics.surface_tension == "stress" and physics.sigma > 0:
-        try:
-            stress_neighbourhood(physics.re_ratio)
-        except ParameterError as e:
-            fail("re_ratio", e.value, "the stress model's constants (C4's factor, C5's delta) "
-                 "are measured at two neighbourhoods only (method.md §4c)", e.allowed)
-    model = Model.of(physics, numerics)
+    try:
+        model = Model.of(physics, numerics)
+    except ParameterError as e:      # the stress member at an re it has no constants for
+        fail(e.key, e.value, "the stress model's constants (C4's factor, C5's delta) are "
+             "measured at two neighbourhoods only (method.md §4c)", e.allowed)
     _check_mach(scene, numerics, physics, fail, where, derived)
 
     # the time step

@@ -210,7 +210,7 @@ class Model:
     viscosity_model: str = "laplacian"   # the family member (core/viscosity.py)
     # re/l0 whose constants the stress member compiles in (STRESS_NEIGHBOURHOODS); the seed's
     # 2.1 for the other members, so a simulator of theirs serves any re (control.Session)
-    stress_re_ratio: float = 2.1
+    stress_re_ratio: float = Physics.re_ratio
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
@@ -225,7 +225,7 @@ class Model:
                    numerics.surface_tension,
                    max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio) if stress else 1.0,
                    numerics.viscosity,
-                   stress_neighbourhood(physics.re_ratio) if stress else 2.1)
+                   stress_neighbourhood(physics.re_ratio) if stress else Physics.re_ratio)
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
