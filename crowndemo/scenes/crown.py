@@ -16,7 +16,8 @@ import numpy as np
 from ..core.params import GRAVITY, WATER, Numerics, Physics, with_values
 from ..core.lattice import wall_layers
 from ..core.symmetry import fraction, plane_names, planes_of
-from .base import Scene, assemble, container_walls, floor_face, lattice_block, particle_faces
+from .base import (Scene, assemble, container_walls, floor_cut, floor_face, lattice_block,
+                   particle_faces)
 
 
 def crown_base_radius(t: float, U: float, D: float, h: float) -> float:
@@ -107,8 +108,8 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
         walls = (walls[0][keep], walls[1][keep])
     margin = (layers + 1) * l0
     top = centre_z + radius + speed * t_end + 0.05
-    domain = (tuple([-half - margin] * (dim - 1) + [-margin]),
-              tuple([half + margin] * (dim - 1) + [top]))
+    domain = floor_cut((tuple([-half - margin] * dim), tuple([half + margin] * (dim - 1) + [top])),
+                       l0)
     left_out = []
     if trimmed:
         left_out.append(f"film beyond r = {extent * 1e3:.1f} mm (of {half * 1e3:.0f} mm): the "

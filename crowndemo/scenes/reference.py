@@ -12,7 +12,7 @@ import numpy as np
 from ..core.params import GRAVITY, WATER, Numerics, Physics
 from ..core.state import FLUID
 from ..core.lattice import wall_layers
-from .base import (Scene, assemble, container_walls, floor_face, lattice_block,
+from .base import (Scene, assemble, container_walls, floor_cut, floor_face, lattice_block,
                    particle_faces)
 
 
@@ -38,7 +38,8 @@ def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, dept
     faces = particle_faces(_walls_faces(dim), dim, numerics)
     walls = container_walls([0.0] * dim, inner_hi, l0, layers, faces)
     margin = (layers + 1) * l0
-    domain = (tuple([-margin] * dim), tuple([width + margin] * (dim - 1) + [3.0 * depth]))
+    domain = floor_cut((tuple([-margin] * dim),
+                        tuple([width + margin] * (dim - 1) + [3.0 * depth])), l0)
     info = {"scene": "hydrostatic tank", "width_m": width, "depth_m": depth,
             "walls": faces, "wall_top_m": inner_hi[-1]}
     return assemble("tank", ph, numerics or Numerics(), fluid, None, walls, domain, t_end, info)
@@ -59,8 +60,8 @@ def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float =
     faces = particle_faces(_walls_faces(dim), dim, numerics)
     walls = container_walls([0.0] * dim, inner_hi, l0, layers, faces)
     margin = (layers + 1) * l0
-    domain = (tuple([-margin] * dim),
-              tuple([length * a + margin] + [channel * a + margin] * (dim - 2) + [6.0 * a]))
+    hi = [length * a + margin] + [channel * a + margin] * (dim - 2) + [6.0 * a]
+    domain = floor_cut((tuple([-margin] * dim), tuple(hi)), l0)
     info = {"scene": "dam break", "a_m": a, "length_a": length, "channel_a": channel,
             "walls": faces, "wall_top_m": inner_hi[-1]}
     return assemble("dam-break", ph, numerics or Numerics(), fluid, None, walls, domain, t_end,
@@ -173,8 +174,8 @@ def sliding_layer(dim: int = 2, delta: float = 1.0e-3, l0: float = 1.0e-4,
     faces = particle_faces([floor_face(dim)], dim, numerics)
     walls = container_walls(floor_lo, floor_hi, l0, layers, faces) if faces else None
     margin = (layers + 2) * l0
-    domain = (tuple(x - margin for x in floor_lo),
-              tuple(x + margin for x in floor_hi[:-1]) + (2.0 * depth,))
+    domain = floor_cut((tuple(x - margin for x in floor_lo),
+                        tuple(x + margin for x in floor_hi[:-1]) + (2.0 * depth,)), l0)
     info = {"scene": "sliding layer", "delta_m": delta, "speed_m_s": amplitude,
             "depth_m": depth, "length_m": length,
             "deficit_m2_s": amplitude * delta / math.sqrt(math.pi), "walls": faces}
