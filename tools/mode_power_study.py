@@ -4,7 +4,7 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
     .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
                           [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
-                          [--threads N]
+                          [--pair-support H] [--tolman DELTA] [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
 numerics with V1, nu = 1e-5 unless --nu), run P mode-2 periods (default 5). With --kick K the
@@ -16,7 +16,10 @@ speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: 
 (the case's 2.1; the member's constants there, params.STRESS_NEIGHBOURHOODS, or F = 1 and
 2.1 l0's delta where it has none); --c4-factor F|lattice: C4's factor F in place of the
 neighbourhood's, or the flat lattice face's balance at the run's re
-(tools/stress_surface_study.py's option). F frames a period (default 40); at each:
+(tools/stress_surface_study.py's option); --pair-support H: C3's pair support H l0 in place
+of the member's 3 (params.STRESS_PAIR_SUPPORT); --tolman DELTA: C5's delta in place of the
+neighbourhood's (0 compiles C5 out); both as in tools/stress_surface_study.py. F frames a
+period (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
@@ -126,10 +129,17 @@ def main() -> None:
     ap.add_argument("--re-ratio", type=float, default=None, help="re / l0 (default: the case's)")
     ap.add_argument("--c4-factor", default=None, metavar="F|lattice",
                     help="C4's factor (the member's 1), or 'lattice': the face balance at re")
+    ap.add_argument("--pair-support", type=float, default=None, metavar="H",
+                    help="C3's pair support in l0 (params.STRESS_PAIR_SUPPORT, the member's 3)")
+    ap.add_argument("--tolman", type=float, default=None, metavar="DELTA",
+                    help="C5's delta in l0 (the neighbourhood's unless given; 0: C5 off)")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
     backend.init("cpu", threads=a.threads)
+    if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
+        import crowndemo.core.params as params_module
+        params_module.STRESS_PAIR_SUPPORT = a.pair_support
     from crowndemo.core import Numerics
     from crowndemo.core.state import FLUID
     from crowndemo.scenes.drop import drop_sound_speed, oscillating_drop
@@ -163,6 +173,10 @@ def main() -> None:
         from stress_surface_study import c4_factor_member, c4_factor_value
         factor = c4_factor_value(a.c4_factor, a.dim, scene.physics.re_ratio)
         family.MODELS["stress"] = c4_factor_member(family.MODELS["stress"], factor)
+    if a.tolman is not None:
+        import crowndemo.core.surface_tension as family
+        from stress_surface_study import tolman_delta_member
+        family.MODELS["stress"] = tolman_delta_member(family.MODELS["stress"], a.tolman)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1
