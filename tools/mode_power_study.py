@@ -4,7 +4,8 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
     .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
                           [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
-                          [--pair-support H] [--tolman DELTA] [--threads N]
+                          [--pair-support H] [--tolman DELTA] [--tolman-form particle]
+                          [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
 numerics with V1, nu = 1e-5 unless --nu), run P mode-2 periods (default 5). With --kick K the
@@ -18,8 +19,9 @@ speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: 
 neighbourhood's, or the flat lattice face's balance at the run's re
 (tools/stress_surface_study.py's option); --pair-support H: C3's pair support H l0 in place
 of the member's 3 (params.STRESS_PAIR_SUPPORT); --tolman DELTA: C5's delta in place of the
-neighbourhood's (0 compiles C5 out); both as in tools/stress_surface_study.py. F frames a
-period (default 40); at each:
+neighbourhood's (0 compiles C5 out); --tolman-form particle: C5's s_i on particle i's whole
+pull (no Marangoni term); all three as in tools/stress_surface_study.py. F frames a period
+(default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
   mean fitted by a linear field v = G d; G's symmetric traceless part is mode 2's flow u_m
@@ -133,6 +135,8 @@ def main() -> None:
                     help="C3's pair support in l0 (params.STRESS_PAIR_SUPPORT, the member's 3)")
     ap.add_argument("--tolman", type=float, default=None, metavar="DELTA",
                     help="C5's delta in l0 (the neighbourhood's unless given; 0: C5 off)")
+    ap.add_argument("--tolman-form", choices=("pair", "particle"), default="pair",
+                    help="C5's s on each T in the pairs (the member's) or on i's whole pull")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -177,6 +181,10 @@ def main() -> None:
         import crowndemo.core.surface_tension as family
         from stress_surface_study import tolman_delta_member
         family.MODELS["stress"] = tolman_delta_member(family.MODELS["stress"], a.tolman)
+    if a.tolman_form == "particle":
+        import crowndemo.core.surface_tension as family
+        from stress_surface_study import tolman_particle_member
+        family.MODELS["stress"] = tolman_particle_member(family.MODELS["stress"])
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1

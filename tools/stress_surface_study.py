@@ -8,7 +8,9 @@ layer does" and after, issue 23), reproducible:
                           [--tangential-moment] [--every MS]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
-                          [--tolman DELTA | --tolman-pass DELTA [--tolman-fit]]
+                          [--tolman DELTA] [--tolman-form pair|particle|smoothed|lagged]
+                          [--tolman-steps N]
+                          [--tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
@@ -68,7 +70,11 @@ the tension acts between surface particles only (an inner particle, g = 0, takes
 pull), a rescaled so that a flat lattice face still carries sigma (membrane_ratio).
 ``--tolman DELTA``: C5's delta (StressTension.tolman_delta) in place of the neighbourhood's
 (params.STRESS_NEIGHBOURHOODS), 0 for the member before C5 (``--base first`` runs without C5
-unless given); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
+unless given); ``--tolman-form particle``: C5's s_i on particle i's whole pull instead of on
+each T in the pairs (tolman_particle_member: no Marangoni term), ``smoothed``: the member's
+with s_i smoothed over the surface within re (tolman_smoothed_member, a third pass),
+``lagged``: s_i through a first-order lag of ``--tolman-steps N`` steps from its first
+step's value (tolman_lagged_member); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
 step's normals in a third pass between pass 1 and pass 2 (tolman_member), with
 ``--tolman-fit`` H_i from the curvature member's surface fit instead of the normals'
 divergence (tolman_fit_member).
@@ -239,6 +245,113 @@ def tolman_delta_member(base, delta: float):
     """``base`` with C5's delta ``delta`` (l0) in place of its neighbourhood's (``--tolman``;
     StressTension.tolman_delta, read at __init__; 0 compiles C5 out)."""
     return ti.data_oriented(type("TolmanDeltaStress", (base,), {"tolman_delta": float(delta)}))
+
+
+def tolman_particle_member(base):
+    """``--tolman-form particle``: C5's s_i taken on particle i's whole pull, a_i = s_i (K_d /
+    rho) sum_j (T_i + T_j) r_ij f_d, instead of on each particle's own T in the pairs (the
+    member's (s_i T_i + s_j T_j)). The member's form is the divergence of s T, which holds
+    the Marangoni term T . grad s: a tension varying along the surface with its curvature
+    pulls the surface toward the flatter parts, and on an oscillating drop that flow is
+    viscous work. This one scales the pull where it acts and has no such term; its pairs are
+    no longer antisymmetric (momentum is kept only as far as s_i ~ s_j)."""
+    from crowndemo.core.state import FLUID, GONE
+
+    class TolmanParticleStress(base):
+        @ti.func
+        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+            kind_j = self.state.kind[j]
+            if kind_j != GONE:
+                r = ti.sqrt(r2)
+                gi, gj = self.colour[i], self.colour[j]
+                f = _stress.stress_times(gi, rij)
+                if kind_j == FLUID:
+                    f += _stress.stress_times(gj, rij)
+                acc.a += f * self._tension(i) * self._pair_weight(r)
+                if ti.static(self.delta > 0.0):
+                    g_min = _stress.NORMAL_MIN / self.coef.l0[None]
+                    if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
+                        acc.h += _stress.normal_divergence_terms(
+                            gi.normalized(), gj.normalized(), rij,
+                            _stress.stress_kernel(r, self.coef.re[None]))
+    return ti.data_oriented(TolmanParticleStress)
+
+
+def tolman_smoothed_member(base):
+    """``--tolman-form smoothed``: C5's s_i replaced, before it is used, by its Shepard mean
+    over i and its surface neighbours within re (those with |g| l0 > NORMAL_MIN, weighted by
+    C1's f(r)), so s varies over the surface on the scale of re rather than particle by
+    particle (a third pass; the pairs stay the member's, antisymmetric)."""
+    from crowndemo.core.state import FLUID, GONE
+
+    class TolmanSmoothedStress(base):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.tolman_mean = ti.field(float, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._colour()
+            if self.symmetry is not None:
+                self._sync_images()
+            self._divergence()
+            self._smooth()
+            self._surface_pressure()
+
+        @ti.func
+        def _mean_pair(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] == FLUID and \
+                    self.colour[j].norm() * self.coef.l0[None] > _stress.NORMAL_MIN:
+                w = _stress.stress_kernel(ti.sqrt(r2), self.coef.re[None])
+                acc += ti.Vector([w * self.tolman_next[j], w])
+
+        @ti.kernel
+        def _smooth(self):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                s = self.tolman_next[i]
+                if self.state.kind[i] == FLUID and \
+                        self.colour[i].norm() * self.coef.l0[None] > _stress.NORMAL_MIN:
+                    acc = ti.Vector([s, 1.0])               # i itself, f(0) = 1
+                    self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                 self._mean_pair, acc)
+                    s = acc[0] / acc[1]
+                self.tolman_mean[i] = s
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                self.tolman_next[i] = self.tolman_mean[i]
+    return ti.data_oriented(TolmanSmoothedStress)
+
+
+def tolman_lagged_member(base, steps: float):
+    """``--tolman-form lagged --tolman-steps N``: C5's s_i follows this step's value through a
+    first-order lag of N steps, s <- s + (s_now - s) / N, from the value of i's first step:
+    the static curvature's correction without following the mode's own (a probe: N steps is
+    no physical time)."""
+    from crowndemo.core.state import FLUID
+
+    class TolmanLaggedStress(base):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.tolman_seen = ti.field(ti.i32, self.state.capacity)
+
+        def boundary_pressure(self) -> None:
+            self._colour()
+            if self.symmetry is not None:
+                self._sync_images()
+            self._divergence()
+            self._lag(1.0 / steps)
+            self._surface_pressure()
+
+        @ti.kernel
+        def _lag(self, rate: float):
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                if self.state.kind[i] == FLUID:
+                    if self.tolman_seen[i] == 1:
+                        self.tolman_next[i] = self.tolman[i] + rate * (
+                            self.tolman_next[i] - self.tolman[i])
+                    self.tolman_seen[i] = 1
+    return ti.data_oriented(TolmanLaggedStress)
 
 
 def c4_factor_value(arg: str, dim: int, re_over_l0: float) -> float:
@@ -1159,6 +1272,15 @@ def main() -> None:
     ap.add_argument("--tolman", type=float, default=None,
                     help="C5's delta (l0) for this run's dimension (default: the base's; "
                          "--base first: 0)")
+    ap.add_argument("--tolman-steps", type=float, default=1000.0, metavar="N",
+                    help="--tolman-form lagged: the lag in steps")
+    ap.add_argument("--tolman-form", choices=("pair", "particle", "smoothed", "lagged"),
+                    default="pair",
+                    help="C5's s on each T in the pairs (the member's), on particle i's "
+                         "whole pull (tolman_particle_member: no Marangoni term), or the "
+                         "member's with s smoothed over the surface within re "
+                         "(tolman_smoothed_member), or lagged by --tolman-steps "
+                         "(tolman_lagged_member)")
     ap.add_argument("--tolman-pass", type=float, default=None, metavar="DELTA",
                     help="the study's C5: a third pass, s_i of this step (tolman_member); "
                          "C5 itself off")
@@ -1256,6 +1378,12 @@ def main() -> None:
         admit_neighbourhood(a.re_ratio)
     if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
         member = tolman_delta_member(member, 0.0 if a.tolman is None else a.tolman)
+    if a.tolman_form == "particle":
+        member = tolman_particle_member(member)
+    elif a.tolman_form == "smoothed":
+        member = tolman_smoothed_member(member)
+    elif a.tolman_form == "lagged":
+        member = tolman_lagged_member(member, a.tolman_steps)
     if a.tolman_pass is not None:
         if a.tolman is not None:
             raise SystemExit("--tolman-pass: not with --tolman")
