@@ -4,7 +4,8 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
     .venv/bin/python tools/mode_power_study.py DIM R/l0 [--periods P] [--kick K] [--nu NU]
                           [--frames F] [--numerics KEY=VALUE ...] [--sound-factor S]
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
-                          [--pair-support H] [--tolman DELTA] [--tolman-form particle]
+                          [--pair-support H] [--tolman DELTA]
+                          [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -19,8 +20,9 @@ speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: 
 neighbourhood's, or the flat lattice face's balance at the run's re
 (tools/stress_surface_study.py's option); --pair-support H: C3's pair support H l0 in place
 of the member's 3 (params.STRESS_PAIR_SUPPORT); --tolman DELTA: C5's delta in place of the
-neighbourhood's (0 compiles C5 out); --tolman-form particle: C5's s_i on particle i's whole
-pull (no Marangoni term); all three as in tools/stress_surface_study.py. F frames a period
+neighbourhood's (0 compiles C5 out); --tolman-form / --tolman-steps: C5's probes (s_i on
+i's whole pull, smoothed over the surface, or lagged N steps); all as in
+tools/stress_surface_study.py. F frames a period
 (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
@@ -135,8 +137,10 @@ def main() -> None:
                     help="C3's pair support in l0 (params.STRESS_PAIR_SUPPORT, the member's 3)")
     ap.add_argument("--tolman", type=float, default=None, metavar="DELTA",
                     help="C5's delta in l0 (the neighbourhood's unless given; 0: C5 off)")
-    ap.add_argument("--tolman-form", choices=("pair", "particle"), default="pair",
-                    help="C5's s on each T in the pairs (the member's) or on i's whole pull")
+    ap.add_argument("--tolman-form", choices=("pair", "particle", "smoothed", "lagged"),
+                    default="pair", help="C5's form (tools/stress_surface_study.py's option)")
+    ap.add_argument("--tolman-steps", type=float, default=1000.0, metavar="N",
+                    help="--tolman-form lagged: the lag in steps")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -181,10 +185,14 @@ def main() -> None:
         import crowndemo.core.surface_tension as family
         from stress_surface_study import tolman_delta_member
         family.MODELS["stress"] = tolman_delta_member(family.MODELS["stress"], a.tolman)
-    if a.tolman_form == "particle":
+    if a.tolman_form != "pair":
         import crowndemo.core.surface_tension as family
-        from stress_surface_study import tolman_particle_member
-        family.MODELS["stress"] = tolman_particle_member(family.MODELS["stress"])
+        import stress_surface_study as study
+        base = family.MODELS["stress"]
+        family.MODELS["stress"] = (
+            study.tolman_particle_member(base) if a.tolman_form == "particle" else
+            study.tolman_smoothed_member(base) if a.tolman_form == "smoothed" else
+            study.tolman_lagged_member(base, a.tolman_steps))
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1
