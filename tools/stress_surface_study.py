@@ -255,26 +255,30 @@ def tolman_particle_member(base):
     pulls the surface toward the flatter parts, and on an oscillating drop that flow is
     viscous work. This one scales the pull where it acts and has no such term; its pairs are
     no longer antisymmetric (momentum is kept only as far as s_i ~ s_j)."""
-    from crowndemo.core.state import FLUID, GONE
+    from crowndemo.core.state import FLUID
 
     class TolmanParticleStress(base):
         @ti.func
-        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
-            kind_j = self.state.kind[j]
-            if kind_j != GONE:
-                r = ti.sqrt(r2)
-                gi, gj = self.colour[i], self.colour[j]
-                f = _stress.stress_times(gi, rij)
-                if kind_j == FLUID:
-                    f += _stress.stress_times(gj, rij)
-                acc.a += f * self._tension(i) * self._pair_weight(r)
-                if ti.static(self.delta > 0.0):
-                    g_min = _stress.NORMAL_MIN / self.coef.l0[None]
-                    if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
-                        acc.h += _stress.normal_divergence_terms(
-                            gi.normalized(), gj.normalized(), rij,
-                            _stress.stress_kernel(r, self.coef.re[None]))
+        def _pair_tension(self, i, j, gi, gj, rij):
+            f = _stress.stress_times(gi, rij)
+            if self.state.kind[j] == FLUID:
+                f += _stress.stress_times(gj, rij)
+            return f * self._tension(i)
     return ti.data_oriented(TolmanParticleStress)
+
+
+def _c5_pass_member(base):
+    """``base`` with the member's passes and ``_c5_pass`` between pass 2 and C4, where pass 2
+    has left C5's next s_i in tolman_next and C4 has yet to take it."""
+    class C5PassStress(base):
+        def boundary_pressure(self) -> None:
+            self._colour()
+            if self.symmetry is not None:
+                self._sync_images()
+            self._divergence()
+            self._c5_pass()
+            self._surface_pressure()
+    return C5PassStress
 
 
 def tolman_smoothed_member(base):
@@ -282,20 +286,15 @@ def tolman_smoothed_member(base):
     over i and its surface neighbours within re (those with |g| l0 > NORMAL_MIN, weighted by
     C1's f(r)), so s varies over the surface on the scale of re rather than particle by
     particle (a third pass; the pairs stay the member's, antisymmetric)."""
-    from crowndemo.core.state import FLUID, GONE
+    from crowndemo.core.state import FLUID
 
-    class TolmanSmoothedStress(base):
+    class TolmanSmoothedStress(_c5_pass_member(base)):
         def __init__(self, model, grid, coef):
             super().__init__(model, grid, coef)
             self.tolman_mean = ti.field(float, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
-            self._colour()
-            if self.symmetry is not None:
-                self._sync_images()
-            self._divergence()
+        def _c5_pass(self) -> None:
             self._smooth()
-            self._surface_pressure()
 
         @ti.func
         def _mean_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -329,18 +328,13 @@ def tolman_lagged_member(base, steps: float):
     no physical time)."""
     from crowndemo.core.state import FLUID
 
-    class TolmanLaggedStress(base):
+    class TolmanLaggedStress(_c5_pass_member(base)):
         def __init__(self, model, grid, coef):
             super().__init__(model, grid, coef)
             self.tolman_seen = ti.field(ti.i32, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
-            self._colour()
-            if self.symmetry is not None:
-                self._sync_images()
-            self._divergence()
+        def _c5_pass(self) -> None:
             self._lag(1.0 / steps)
-            self._surface_pressure()
 
         @ti.kernel
         def _lag(self, rate: float):

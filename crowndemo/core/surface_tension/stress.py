@@ -234,15 +234,20 @@ class StressTension:
         return stress_pair_kernel(r, params.STRESS_PAIR_SUPPORT * l0, l0)   # H (compile time)
 
     @ti.func
+    def _pair_tension(self, i, j, gi, gj, rij):
+        """(s_i T_i + s_j T_j) r_ij (C3, C5), T_j = 0 for walls and dummies."""
+        f = stress_times(gi, rij) * self._tension(i)
+        if self.state.kind[j] == FLUID:
+            f += stress_times(gj, rij) * self._tension(j)
+        return f
+
+    @ti.func
     def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
         kind_j = self.state.kind[j]
         if kind_j != GONE:
             r = ti.sqrt(r2)
             gi, gj = self.colour[i], self.colour[j]
-            f = stress_times(gi, rij) * self._tension(i)
-            if kind_j == FLUID:
-                f += stress_times(gj, rij) * self._tension(j)
-            acc.a += f * self._pair_weight(r)
+            acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r)
             if ti.static(self.delta > 0.0):
                 g_min = NORMAL_MIN / self.coef.l0[None]
                 if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
