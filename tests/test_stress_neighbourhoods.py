@@ -15,7 +15,7 @@ import pytest
 
 from crowndemo.core import Numerics, Physics
 from crowndemo.core.lattice import face_balance_factor, stress_constants
-from crowndemo.core.params import STRESS_NEIGHBOURHOODS, Model, ParameterError
+from crowndemo.core.params import STRESS_NEIGHBOURHOODS, STRESS_TOLMAN_LAG, Model, ParameterError
 
 SIGMA, RHO = 0.0728, 998.0
 
@@ -91,6 +91,8 @@ def test_info_gives_the_wider_neighbourhoods_constants(capsys):
     st = json.loads(capsys.readouterr().out)["surface_tension"]
     assert st["constants"]["F"] == pytest.approx(face_push_factor(2, 3.1), rel=1e-12)
     assert st["constants"]["delta_l0"] == 0.9
+    # C5's lag (method.md §4c), wherever C5 is on
+    assert st["constants"]["lag_capillary_times"] == STRESS_TOLMAN_LAG
     # the run time's costs are measured at 2.1 l0: info says so, with the lattice's neighbours
     # within re (2D: 12 at 2.1 l0, 28 at 3.1 l0; the points of the square lattice in a circle)
     assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress",

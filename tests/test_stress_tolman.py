@@ -13,7 +13,7 @@ import pytest
 
 from crowndemo.core import FLUID, Numerics, Physics, Simulator
 from crowndemo.core.params import STRESS_NEIGHBOURHOODS
-from crowndemo.core.surface_tension.stress import NORMAL_MIN
+from crowndemo.core.surface_tension.stress import NORMAL_MIN, TOLMAN_LAG, UNSET
 
 L0 = 1.0e-4
 SEED_DELTAS = STRESS_NEIGHBOURHOODS[2.1]["tolman"]     # the seed's neighbourhood, re = 2.1 l0
@@ -27,14 +27,15 @@ def sim3():
                                     collision=0.0), 18000)
 
 
-def passes(sim: Simulator, pos: np.ndarray, times: int = 1):
-    """Load ``pos`` at rest and run the member's passes ``times`` times (each computes the
-    factor s the next one uses); the mean curvature H = (1 - s)/(delta l0) C5 read on the last,
-    |g|, the acceleration and the positions as the device holds them."""
+def passes(sim: Simulator, pos: np.ndarray, times: int = 1, dt: float = 1e-6):
+    """Load ``pos`` at rest and run the member's passes ``times`` times, steps of ``dt`` (each
+    computes the factor s the next one uses; the first sets it); the mean curvature H = (1 -
+    s)/(delta l0) C5 read on the last, |g|, the acceleration and the positions as the device
+    holds them."""
     sim.load(pos, np.zeros_like(pos), np.full(len(pos), FLUID, dtype=np.int32))
     sim.grid.build(sim.lattice.re)
     for _ in range(times):
-        sim.pressure.density_and_pressure()
+        sim.pressure.density_and_pressure(dt)
     n = sim.state.count
     m = sim.surface_tension
     s = m.tolman.to_numpy()[:n].astype(float)
@@ -106,7 +107,7 @@ def test_pair_forces_sum_to_zero_with_the_correction(sim3):
 def test_the_factor_follows_its_particle(sim3):
     """A re-sort permutes the carried factor with the particles; ``dump`` keeps it and
     ``restore`` of a dump without it (an older checkpoint) leaves it as it is; ``load``
-    resets it to 1."""
+    resets it to unset (its particle's first step sets it)."""
     import taichi as ti
     state = sim3.state
     k = np.arange(6)
@@ -114,7 +115,7 @@ def test_the_factor_follows_its_particle(sim3):
     sim3.load(pts.astype(float), np.zeros_like(pts, dtype=float),
               np.full(len(pts), FLUID, dtype=np.int32))
     n = state.count
-    assert np.all(sim3.surface_tension.tolman.to_numpy()[:n] == 1.0)
+    assert np.all(sim3.surface_tension.tolman.to_numpy()[:n] == UNSET)
     mark = np.zeros(state.capacity, dtype=sim3.surface_tension.tolman.to_numpy().dtype)
     mark[:n] = 1.0 + np.arange(n) / n                     # a value per particle id
     sim3.surface_tension.tolman.from_numpy(mark)
@@ -133,3 +134,46 @@ def test_the_factor_follows_its_particle(sim3):
     assert np.all(sim3.surface_tension.tolman.to_numpy()[:n] == 0.5)
     state.restore(saved)
     np.testing.assert_array_equal(sim3.surface_tension.tolman.to_numpy()[:n], mark[pid])
+
+
+def ball(R: int) -> np.ndarray:
+    """A ball of shells l0 apart, the outermost at R - l0/2 (test_mean_curvature_...'s)."""
+    return np.concatenate([np.zeros((1, 3))] + [
+        sphere_points(max(int(round(4 * np.pi * r * r)), 1), r) for r in R - 0.5 - np.arange(R)])
+
+
+def test_the_factor_follows_the_curvature_over_its_capillary_time(sim3):
+    """C5's lag: the particles of a flat slab (H_A ~ 0 on its face) put into a ball of R =
+    12 l0 (H_B = 1/r on its surface): s_i relaxes to the ball's value s_B as the first-order
+    lag's exact step response, s_A + (s_B - s_A)(1 - exp(-t/tau)), tau = TOLMAN_LAG sqrt(rho /
+    (sigma |H_B|^3)) the capillary time of the new curvature (where |H_B| >= |H_A|, so tau
+    stays that one); a pass for output (dt = 0) moves nothing."""
+    m = sim3.surface_tension
+    pos = ball(12) * L0
+    k = np.arange(24)
+    slab = np.stack(np.meshgrid(k, k, k, indexing="ij"), -1).reshape(-1, 3)[:len(pos)] * L0
+    H_A, _, _, _ = passes(sim3, slab.astype(float))        # the first step sets s_A
+    s_A = 1.0 - DELTA * L0 * H_A
+    dtype = sim3.state.pos.to_numpy().dtype
+    sim3.state.pos.from_numpy(np.concatenate([pos, np.zeros(
+        (sim3.state.capacity - len(pos), 3))]).astype(dtype))
+    sim3.grid.build(sim3.lattice.re)
+    sim3.pressure.density_and_pressure(0.0)               # output: s stays
+    n = sim3.state.count
+    np.testing.assert_array_equal(m.tolman.to_numpy()[:n], s_A.astype(dtype))
+    s_B = m.tolman_next.to_numpy()[:n].astype(float)     # the ball's own s
+    g = np.linalg.norm(m.colour.to_numpy()[:n].astype(float), axis=1)
+    dt, steps = 2.0e-3, 4
+    for _ in range(steps):
+        sim3.pressure.density_and_pressure(dt)
+    s = m.tolman.to_numpy()[:n].astype(float)
+    H_B = (1.0 - s_B) / (DELTA * L0)
+    on = (g * L0 > NORMAL_MIN) & (np.abs(H_B) >= np.abs(H_A)) & (np.abs(H_B) > 0.0)
+    assert on.sum() > 0.5 * 4 * np.pi * 11.5 ** 2         # most of the outer shell
+    tau = TOLMAN_LAG * np.sqrt(998.0 / (0.0728 * np.abs(H_B[on]) ** 3))
+    r = np.linalg.norm(pos[on], axis=1)
+    assert np.median(tau) == pytest.approx(np.median(
+        TOLMAN_LAG * np.sqrt(998.0 * r ** 3 / 0.0728)), rel=0.05)     # the ball's 1/r
+    expected = s_B[on] + (s_A[on] - s_B[on]) * np.exp(-steps * dt / tau)
+    np.testing.assert_allclose(s[on], expected, atol=2e-5)
+    assert np.median(np.abs(s[on] - s_B[on])) > 0.1 * np.median(np.abs(s_A[on] - s_B[on]))

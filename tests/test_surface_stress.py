@@ -244,7 +244,8 @@ def test_info_names_the_model_and_its_constants(capsys):
     assert st["model"] == "stress"
     assert st["constants"]["a"] == pytest.approx(stress_normaliser(2, 1.0, 2.1), rel=1e-9)
     assert st["constants"]["K_1_m2"] == pytest.approx(lat.stress_K, rel=1e-9)
-    assert "delta_l0" not in st["constants"]          # C5 is 3D's
+    # C5 is 3D's at 2.1 l0: no delta, no lag
+    assert "delta_l0" not in st["constants"] and "lag_capillary_times" not in st["constants"]
     assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress"]) == 0
     assert "tension     stress: the continuum surface stress" in capsys.readouterr().out
     assert st["constants"]["F"] == 1.0                 # C4's factor at 2.1 l0

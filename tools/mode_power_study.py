@@ -6,6 +6,7 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
                           [--pair-support H] [--tolman DELTA]
                           [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
+                          [--tolman-lag K]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -21,7 +22,8 @@ neighbourhood's, or the flat lattice face's balance at the run's re
 (tools/stress_surface_study.py's option); --pair-support H: C3's pair support H l0 in place
 of the member's 3 (params.STRESS_PAIR_SUPPORT); --tolman DELTA: C5's delta in place of the
 neighbourhood's (0 compiles C5 out); --tolman-form / --tolman-steps: C5's probes (s_i on
-i's whole pull, smoothed over the surface, or lagged N steps); all as in
+i's whole pull, smoothed over the surface, or lagged N steps); --tolman-lag K: the member's
+lag of C5 in capillary times (0: none, the member to 2026-12-07); all as in
 tools/stress_surface_study.py. F frames a period
 (default 40); at each:
 
@@ -141,6 +143,8 @@ def main() -> None:
                     default="pair", help="C5's form (tools/stress_surface_study.py's option)")
     ap.add_argument("--tolman-steps", type=float, default=1000.0, metavar="N",
                     help="--tolman-form lagged: the lag in steps")
+    ap.add_argument("--tolman-lag", type=float, default=None, metavar="K",
+                    help="C5's lag in capillary times (stress_surface_study --tolman-lag)")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -185,14 +189,11 @@ def main() -> None:
         import crowndemo.core.surface_tension as family
         from stress_surface_study import tolman_delta_member
         family.MODELS["stress"] = tolman_delta_member(family.MODELS["stress"], a.tolman)
-    if a.tolman_form != "pair":
+    if a.tolman_form != "pair" or a.tolman_lag is not None:
         import crowndemo.core.surface_tension as family
-        import stress_surface_study as study
-        base = family.MODELS["stress"]
-        family.MODELS["stress"] = (
-            study.tolman_particle_member(base) if a.tolman_form == "particle" else
-            study.tolman_smoothed_member(base) if a.tolman_form == "smoothed" else
-            study.tolman_lagged_member(base, a.tolman_steps))
+        from stress_surface_study import tolman_form_member
+        family.MODELS["stress"] = tolman_form_member(family.MODELS["stress"], a.tolman_form,
+                                                     a.tolman_steps, a.tolman_lag)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1

@@ -9,7 +9,7 @@ layer does" and after, issue 23), reproducible:
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA] [--tolman-form pair|particle|smoothed|lagged]
-                          [--tolman-steps N]
+                          [--tolman-steps N] [--tolman-lag K]
                           [--tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
@@ -74,7 +74,9 @@ unless given); ``--tolman-form particle``: C5's s_i on particle i's whole pull i
 each T in the pairs (tolman_particle_member: no Marangoni term), ``smoothed``: the member's
 with s_i smoothed over the surface within re (tolman_smoothed_member, a third pass),
 ``lagged``: s_i through a first-order lag of ``--tolman-steps N`` steps from its first
-step's value (tolman_lagged_member); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
+step's value (tolman_lagged_member); ``--tolman-lag K``: the member's lag of s_i in capillary
+times (StressTension.tolman_lag; 0: s_i of the last step, the member to 2026-12-07, on which
+the particle, smoothed and lagged probes ran and run unless K is given); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
 step's normals in a third pass between pass 1 and pass 2 (tolman_member), with
 ``--tolman-fit`` H_i from the curvature member's surface fit instead of the normals'
 divergence (tolman_fit_member).
@@ -135,10 +137,10 @@ def neighbours_pressure_member(base, scaled: bool = False, filtered: bool = Fals
             super().__init__(model, grid, coef)
             self.p_new = ti.field(float, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             self._neighbours_pressure()
             self._commit()
-            super().boundary_pressure()
+            super().boundary_pressure(dt)
 
         @ti.func
         def _pressurised(self, i, j, rij, r2, acc: ti.template()):
@@ -197,8 +199,8 @@ def own_pressure_member(base, factor: float, per_area: bool = False, spacing: bo
 
     @ti.data_oriented
     class OwnPressureStress(base):
-        def boundary_pressure(self) -> None:
-            super().boundary_pressure()
+        def boundary_pressure(self, dt: float = 0.0) -> None:
+            super().boundary_pressure(dt)
             self._own_pressure()
 
         @ti.func
@@ -247,6 +249,22 @@ def tolman_delta_member(base, delta: float):
     return ti.data_oriented(type("TolmanDeltaStress", (base,), {"tolman_delta": float(delta)}))
 
 
+def tolman_form_member(base, form: str, steps: float, lag=None):
+    """``base`` with C5's ``--tolman-form`` (pair: the member's own) and ``--tolman-lag`` (None:
+    the member's TOLMAN_LAG for the pair form, 0 for the probes, measured without it)."""
+    if lag is None and form != "pair":
+        lag = 0.0
+    if lag is not None:
+        base = ti.data_oriented(type("TolmanLagStress", (base,), {"tolman_lag": float(lag)}))
+    if form == "particle":
+        return tolman_particle_member(base)
+    if form == "smoothed":
+        return tolman_smoothed_member(base)
+    if form == "lagged":
+        return tolman_lagged_member(base, steps)
+    return base
+
+
 def tolman_particle_member(base):
     """``--tolman-form particle``: C5's s_i taken on particle i's whole pull, a_i = s_i (K_d /
     rho) sum_j (T_i + T_j) r_ij f_d, instead of on each particle's own T in the pairs (the
@@ -271,13 +289,13 @@ def _c5_pass_member(base):
     """``base`` with the member's passes and ``_c5_pass`` between pass 2 and C4, where pass 2
     has left C5's next s_i in tolman_next and C4 has yet to take it."""
     class C5PassStress(base):
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             self._colour()
             if self.symmetry is not None:
                 self._sync_images()
             self._divergence()
             self._c5_pass()
-            self._surface_pressure()
+            self._surface_pressure(dt)
     return C5PassStress
 
 
@@ -374,8 +392,8 @@ def eos_pressure_member(base, slope: float):
 
     @ti.data_oriented
     class EosPressureStress(base):
-        def boundary_pressure(self) -> None:
-            super().boundary_pressure()
+        def boundary_pressure(self, dt: float = 0.0) -> None:
+            super().boundary_pressure(dt)
             self._eos_surface()
 
         @ti.kernel
@@ -432,9 +450,9 @@ def cumulative_pressure_member(base):
             super().__init__(model, grid, coef)
             self.p_own = ti.field(float, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             self._mark()
-            super().boundary_pressure()
+            super().boundary_pressure(dt)
             self._keep()
             self._cumulate()
 
@@ -474,9 +492,9 @@ def blend_pressure_member(base):
 
     @ti.data_oriented
     class BlendPressureStress(member):
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             self._mark()
-            super().boundary_pressure()
+            super().boundary_pressure(dt)
             self._blend()
 
         @ti.kernel
@@ -611,7 +629,7 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
             super().__init__(model, grid, coef)
             self.share = ti.field(float, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             if self.symmetry is not None:
                 raise SystemExit("--tangential-moment: drops only (no symmetry planes)")
             self._colour()
@@ -831,7 +849,7 @@ def tolman_member(base, delta: float):
             super().__init__(model, grid, coef)
             self.tolman = ti.field(float, self.state.capacity)
 
-        def boundary_pressure(self) -> None:
+        def boundary_pressure(self, dt: float = 0.0) -> None:
             self._colour()
             if self.symmetry is not None:
                 self._sync_images()
@@ -840,7 +858,7 @@ def tolman_member(base, delta: float):
             if self.symmetry is not None:
                 self._sync_images()
             self._divergence()
-            self._surface_pressure()
+            self._surface_pressure(dt)
 
         @ti.func
         def _curvature_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -934,7 +952,7 @@ def zero_surface_member(base):
     it (the first member's; the --surface levers start from it)."""
     @ti.data_oriented
     class ZeroSurfaceStress(base):
-        def _surface_pressure(self) -> None:
+        def _surface_pressure(self, dt: float) -> None:
             pass
 
     return ZeroSurfaceStress
@@ -1268,6 +1286,9 @@ def main() -> None:
                          "--base first: 0)")
     ap.add_argument("--tolman-steps", type=float, default=1000.0, metavar="N",
                     help="--tolman-form lagged: the lag in steps")
+    ap.add_argument("--tolman-lag", type=float, default=None, metavar="K",
+                    help="C5's lag in capillary times (the member's TOLMAN_LAG unless given; "
+                         "0 for the probes of --tolman-form unless given)")
     ap.add_argument("--tolman-form", choices=("pair", "particle", "smoothed", "lagged"),
                     default="pair",
                     help="C5's s on each T in the pairs (the member's), on particle i's "
@@ -1372,12 +1393,7 @@ def main() -> None:
         admit_neighbourhood(a.re_ratio)
     if a.tolman is not None or a.base == "first" or a.tolman_pass is not None:
         member = tolman_delta_member(member, 0.0 if a.tolman is None else a.tolman)
-    if a.tolman_form == "particle":
-        member = tolman_particle_member(member)
-    elif a.tolman_form == "smoothed":
-        member = tolman_smoothed_member(member)
-    elif a.tolman_form == "lagged":
-        member = tolman_lagged_member(member, a.tolman_steps)
+    member = tolman_form_member(member, a.tolman_form, a.tolman_steps, a.tolman_lag)
     if a.tolman_pass is not None:
         if a.tolman is not None:
             raise SystemExit("--tolman-pass: not with --tolman")

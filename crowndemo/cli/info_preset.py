@@ -20,16 +20,18 @@ SURFACE_TENSION_WHAT = {
 
 def surface_tension_summary(model: str, lat, sigma: float) -> dict:
     """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3;
-    the neighbourhood's C4 factor F and C5's delta where it is not 0)."""
+    the neighbourhood's C4 factor F and C5's delta and lag where delta is not 0)."""
     if model == "potential":
         constants = {"C": lat.C}
     elif model == "stress":
         from ..core.lattice import stress_constants
+        from ..core.params import STRESS_TOLMAN_LAG
         factor, delta = stress_constants(lat.dim, lat.re / lat.l0)
         constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd,
                      "F": factor}
         if delta > 0:      # C5's curvature correction (3D; 2D at 3.1 l0)
             constants["delta_l0"] = delta
+            constants["lag_capillary_times"] = STRESS_TOLMAN_LAG
     else:
         constants = {}
     return {"model": model, "what": SURFACE_TENSION_WHAT[model], "sigma_N_m": sigma,
@@ -194,9 +196,11 @@ def info_preset(args) -> int:
           f"{f['lambda0_over_l0_sq']:.6g} l0^2), C {f['C']:.6g} {c_unit}, mass {f['mass']:.6g} "
           f"{f['mass_unit']}")
     st = f["surface_tension"]
-    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "delta_l0": " l0"}
+    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "delta_l0": " l0",
+             "lag_capillary_times": " capillary times"}
     print(f"  tension     {st['model']}: {st['what']}" + "".join(
-        f"; {k.split('_1_')[0].removesuffix('_l0')} {v:.6g}{units.get(k, '')}"
+        f"; {k.split('_1_')[0].removesuffix('_l0').removesuffix('_capillary_times')} "
+        f"{v:.6g}{units.get(k, '')}"
         for k, v in st["constants"].items()))
     print(f"  sound speed c = {f['sound_speed_m_s']:.4g} m/s ({f['sound_speed_source']})")
     n = f["numerics"]

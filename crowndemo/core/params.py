@@ -41,6 +41,11 @@ STRESS_PAIR_SUPPORT = 3.0
 # errors fall with resolution and the decay's excess over Lamb's rate is halved (a 3D
 # particle has 122 lattice neighbours within re against 32; the 3D drop cases ran 1.8-2.2
 # times as long). The constants are measured, not derived: another re is refused.
+# C5's s_i follows its step's value through a first-order lag of this many capillary times
+# sqrt(rho / (sigma |H|^3)) (about 1.6 periods of mode 2 of a drop of radius 1/|H|; method.md
+# §4c): a tension that followed the mode's own bending damped a 3D drop's oscillation
+# (VALIDATION.md, "C5's own damping", "C5 lagged in the surface's capillary time")
+STRESS_TOLMAN_LAG = 3.5
 STRESS_NEIGHBOURHOODS = {2.1: {"c4_factor": 1.0, "tolman": {2: 0.0, 3: 0.80}},
                          3.1: {"c4_factor": "lattice", "tolman": {2: 0.9, 3: 0.80}}}
 

@@ -80,11 +80,12 @@ class Pressure:
     def _floor_density(self, z) -> float:
         return self.floor.at(z)[FLOOR_N]
 
-    def density_and_pressure(self) -> None:
-        """n (S9) and P (S17, M3), then the surface-tension member's boundary pressure."""
+    def density_and_pressure(self, dt: float = 0.0) -> None:
+        """n (S9) and P (S17, M3), then the surface-tension member's boundary pressure; ``dt``
+        the step's (what a member carries from step to step advances by it; 0 for output)."""
         self._density_and_pressure()
         if self.surface is not None:
-            self.surface.boundary_pressure()
+            self.surface.boundary_pressure(dt)
 
     @ti.kernel
     def _density_and_pressure(self):

@@ -341,7 +341,7 @@ class Simulator:
             sym.reflect()                               # nothing crosses a plane
         self._build(reorder and not built)              # at r*
         self._stage("grid")
-        self.pressure.density_and_pressure()            # S17 (M3)
+        self.pressure.density_and_pressure(dt)          # S17 (M3)
         if self.predictor.takes_list:                   # the next predictor's pairs
             self._lists_ready = self.pressure.neighbours.complete()
         if sym is not None:

@@ -8,9 +8,11 @@ A member is a ``ti.data_oriented`` object with
   then ``pair(rij, r)`` (a ``ti.func``, the term of one fluid-fluid pair j of i, r_ij = r_j -
   r_i) and ``finish(acc)`` (a ``ti.func``, the acceleration from the summed terms) are called
   by the predictor under ``ti.static``;
-- ``boundary_pressure()``: called right after the number density and pressure at r* (S17, M3),
-  before the corrector; a member that acts through the pressure sets it there, one that acts
-  in the corrector computes its acceleration there (a no-op else);
+- ``boundary_pressure(dt)``: called right after the number density and pressure at r* (S17,
+  M3), before the corrector; a member that acts through the pressure sets it there, one that
+  acts in the corrector computes its acceleration there (a no-op else); ``dt`` is the step's,
+  0 where the pressure is refreshed for output (what a member carries from step to step, the
+  stress's lagged C5, must not advance then);
 - ``corrector_term`` (optional, False if absent): True if the corrector adds the member's
   ``acceleration(i)`` (a ``ti.func``) to the pressure gradient's (S18);
 - ``attach(floor, symmetry)`` (optional): the simulator's plane floor and mirror planes;

@@ -140,7 +140,7 @@ class CurvatureTension:
     def nbytes(self) -> int:
         return field_nbytes(self.normal) + field_nbytes(self.kappa)
 
-    def boundary_pressure(self) -> None:
+    def boundary_pressure(self, dt: float = 0.0) -> None:
         """kappa at r* (the two passes), then P = sigma kappa on the outer free-surface layer."""
         self._normals()
         self._fit()

@@ -34,7 +34,7 @@ class PotentialTension:
     def finish(self, acc):
         return self.coef.st_over_m[None] * acc
 
-    def boundary_pressure(self) -> None:
+    def boundary_pressure(self, dt: float = 0.0) -> None:
         """The potential acts through the predictor only."""
 
     def nbytes(self) -> int:

@@ -64,8 +64,14 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    the error without C5 times 1 - delta/(R/l0 - 0.6); 0.92, which cancelled the +8.27 % at
    12 alone, over-corrected at 16); in 2D 0 at 2.1 l0 (compiled out), whose drops read
    +4 / +2 / 0 % without it, and 0.9 at 3.1 l0. H_i is summed in pass 2's walk and used in
-   the next step's pass 2 (s_i lags a step, a carried field, so no third pass); the pairs
-   stay antisymmetric, as (s_i T_i + s_j T_j) r_ij f_d.
+   the next step's pass 2 (a carried field, so no third pass); the pairs stay antisymmetric,
+   as (s_i T_i + s_j T_j) r_ij f_d. s_i follows its step's value through a first-order lag
+   of TOLMAN_LAG = 3.5 capillary times sqrt(rho / (sigma |H|^3)) (about 1.6 periods of mode 2
+   of a drop of radius 1/|H|): a tension that followed the mode's own bending pulled the
+   surface toward its stiffer parts (a Marangoni stress) and damped a 3D drop's oscillation
+   1.4-1.5 times as fast as Lamb's rate at re = 3.1 l0; lagged, C5 corrects the surface of
+   tension's static offset alone (VALIDATION.md, "C5's own damping", "C5 lagged in the
+   surface's capillary time").
 
 F and delta are the neighbourhood's (params.STRESS_NEIGHBOURHOODS: re = 2.1 l0, the seed's, or
 3.1 l0, where the 3D drops' errors fall with resolution; another re is refused, its constants
@@ -87,9 +93,11 @@ from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
 TOLMAN_CLAMP = (0.5, 1.5)    # s_i's range (C5): a lone or spray particle's H is no curvature
+TOLMAN_LAG = params.STRESS_TOLMAN_LAG     # C5's lag in capillary times (params.py)
 # C5's normals: of particles with |g| l0 above this (a flat lattice face's outer layer: 0.50,
 # the next 3e-5); below it omega ~ 0 and g can be float rounding, its direction noise
 NORMAL_MIN = 0.1
+UNSET = 0.0     # a carried s_i (C5) before its particle's first step: outside TOLMAN_CLAMP
 
 
 @ti.func
@@ -154,6 +162,7 @@ class StressTension:
     # (tools/stress_surface_study.py --c4-factor, --tolman)
     c4_factor = None
     tolman_delta = None
+    tolman_lag = None          # C5's lag in capillary times: None takes TOLMAN_LAG, 0 none
 
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
@@ -166,10 +175,12 @@ class StressTension:
         self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
         # C5: sigma (1 - delta H), delta in l0; s_i lags one step
         self.delta = delta if self.tolman_delta is None else float(self.tolman_delta)
+        self.lag = TOLMAN_LAG if self.tolman_lag is None else float(self.tolman_lag)
         self.tolman = self.tolman_next = None
         if self.delta > 0.0:
-            self.tolman = self.state.carry("stress_tolman", ti.field(float, cap), 1.0)   # s_i
-            self.tolman_next = ti.field(float, cap)                                  # next
+            # s_i, lagged; 0 until i's first step sets it (UNSET: 1 is used till then)
+            self.tolman = self.state.carry("stress_tolman", ti.field(float, cap), UNSET)
+            self.tolman_next = ti.field(float, cap)            # this step's value, pass 2's
         self.pass_sums = ti.types.struct(a=ti.types.vector(self.dim, float),
                                          h=ti.types.vector(2, float))   # pass 2's: a_i, C5's H_i
         self.symmetry = None     # the mirror planes, where the scene has them
@@ -183,13 +194,14 @@ class StressTension:
                                            else [])
         return sum(field_nbytes(f) for f in own)
 
-    def boundary_pressure(self) -> None:
-        """The two passes (module docstring), then the free surface's pressure (C4)."""
+    def boundary_pressure(self, dt: float = 0.0) -> None:
+        """The two passes (module docstring), then the free surface's pressure (C4) and C5's
+        s_i for the next step, its lag advanced by ``dt`` (0: output, nothing advances)."""
         self._colour()
         if self.symmetry is not None:
             self._sync_images()
         self._divergence()
-        self._surface_pressure()
+        self._surface_pressure(dt)
 
     @ti.func
     def _colour_pair(self, i, j, rij, r2, acc: ti.template()):
@@ -256,10 +268,31 @@ class StressTension:
 
     @ti.func
     def _tension(self, i):
-        """s_i of C5 (1 where the correction is compiled out)."""
+        """s_i of C5 (1 where the correction is compiled out or i has yet to set it)."""
         s = 1.0
         if ti.static(self.delta > 0.0):
-            s = self.tolman[i]
+            s = ti.select(self.tolman[i] > UNSET, self.tolman[i], 1.0)
+        return s
+
+    @ti.func
+    def _followed(self, i, dt):
+        """C5's s_i for the next step: pass 2's s_now through a first-order lag of time tau =
+        lag sqrt(rho / (sigma |H|^3)), the capillary time of the curvature, |H| the larger of
+        the lagged and the present one's (s = 1 - delta l0 H), so the correction follows the
+        surface's mean curvature but not a mode's oscillation about it; s_now at i's first
+        step; unchanged where dt = 0."""
+        s, s_now = self.tolman[i], self.tolman_next[i]
+        if dt > 0.0:
+            if s <= UNSET:
+                s = s_now
+            else:
+                rate = 1.0
+                if ti.static(self.lag > 0.0):
+                    h = ti.max(ti.abs(1.0 - s), ti.abs(1.0 - s_now)) / (
+                        self.delta * self.coef.l0[None])
+                    rate = 1.0 - ti.exp(-dt * ti.sqrt(self.coef.sigma[None] * h * h * h / (
+                        self.coef.rho[None])) / self.lag)
+                s += rate * (s_now - s)
         return s
 
     @ti.kernel
@@ -287,9 +320,9 @@ class StressTension:
                 self.tolman_next[i] = s_next
 
     @ti.kernel
-    def _surface_pressure(self):
+    def _surface_pressure(self, dt: float):
         """C4: P_i = rho l0 max(0, a_i . g_i/|g_i|) for the fluid particles S17/M3 left at
-        P = 0 that have a colour gradient (the free surface: omega_i > 0)."""
+        P = 0 that have a colour gradient (the free surface: omega_i > 0); C5's next s_i."""
         scale = self.surface_factor * self.coef.rho[None] * self.coef.l0[None]
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
@@ -298,7 +331,7 @@ class StressTension:
             if self.state.kind[i] == FLUID and self.state.pressure[i] <= 0.0 and gl > 0.0:
                 self.state.pressure[i] = scale * ti.max(self.accel[i].dot(g) / gl, 0.0)
             if ti.static(self.delta > 0.0):
-                self.tolman[i] = self.tolman_next[i]      # C5: the next step's s_i
+                self.tolman[i] = self._followed(i, dt)      # C5: the next step's s_i
 
     @ti.func
     def acceleration(self, i):
