@@ -40,8 +40,8 @@ FORM = "sum"               # the drops' gradient form (module docstring)
 DISORDER = {2: 0.0, 3: 0.15}
 # The variant on the member's other neighbourhood, re = 3.1 l0 (params.STRESS_NEIGHBOURHOODS):
 # 122 lattice neighbours a particle in 3D against 32, where the 3D drops' Laplace and mode-2
-# errors fall with resolution and the decay's excess over Lamb's rate is halved (VALIDATION.md,
-# "re = 3.1 l0 completed")
+# errors fall with resolution and the decay is 1.2-1.3 times Lamb's rate with C5 lagged
+# (VALIDATION.md, "re = 3.1 l0 completed", "C5 lagged in the surface's capillary time")
 WIDE = "re=3.1"
 
 

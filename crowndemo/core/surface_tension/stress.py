@@ -173,7 +173,7 @@ class StressTension:
         self.floor = None        # the analytic plane floor, where the model has one
         factor, delta = stress_constants(self.dim, model.stress_re_ratio)
         self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
-        # C5: sigma (1 - delta H), delta in l0; s_i lags one step
+        # C5: sigma (1 - delta H), delta in l0; s_i lagged in capillary time (_followed)
         self.delta = delta if self.tolman_delta is None else float(self.tolman_delta)
         self.lag = TOLMAN_LAG if self.tolman_lag is None else float(self.tolman_lag)
         self.tolman = self.tolman_next = None
