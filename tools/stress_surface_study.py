@@ -76,10 +76,11 @@ with s_i smoothed over the surface within re (tolman_smoothed_member, a third pa
 ``lagged``: s_i through a first-order lag of ``--tolman-steps N`` steps from its first
 step's value (tolman_lagged_member); ``--tolman-lag K``: the member's lag of s_i in capillary
 times (StressTension.tolman_lag; 0: s_i of the last step, the member to 2026-12-07, on which
-the particle, smoothed and lagged probes ran and run unless K is given); ``--tolman-pass DELTA``: the study that led to C5 (C5 off): s_i from this
-step's normals in a third pass between pass 1 and pass 2 (tolman_member), with
-``--tolman-fit`` H_i from the curvature member's surface fit instead of the normals'
-divergence (tolman_fit_member).
+the particle, smoothed and lagged probes ran and run unless K is given; but for the frames:
+then a refresh for output set s_i too, now it leaves it); ``--tolman-pass DELTA``: the study
+that led to C5 (C5 off): s_i from this step's normals in a third pass between pass 1 and
+pass 2 (tolman_member), with ``--tolman-fit`` H_i from the curvature member's surface fit
+instead of the normals' divergence (tolman_fit_member).
 ``--nu NU``: the oscillating drop's kinematic viscosity (``case stress-drop-oscillation-*``,
 ``energy``; tension_cases.OSCILLATION_NU, 1e-5); ``--sound-factor F``: every drop's sound
 speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
