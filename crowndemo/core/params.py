@@ -40,7 +40,8 @@ STRESS_PAIR_SUPPORT = 3.0
 # 2.1 l0 is the seed's neighbourhood, the crowns'; at 3.1 l0 the 3D drops' Laplace and mode-2
 # errors fall with resolution and the decay is 1.2-1.3 times Lamb's rate with C5 lagged,
 # 1.5-1.9 at 2.1 l0 (a 3D particle has 122 lattice neighbours within re against 32; the 3D
-# drop cases ran 1.8-2.2 times as long). The constants are measured, not derived: another re is refused.
+# drop cases ran 1.8-2.2 times as long). The constants are measured, not derived: another
+# re is refused.
 # C5's s_i follows its step's value through a first-order lag of this many capillary times
 # sqrt(rho / (sigma |H|^3)) (about 1.6 periods of mode 2 of a drop of radius 1/|H|; method.md
 # §4c): a tension that followed the mode's own bending damped a 3D drop's oscillation
