@@ -344,14 +344,10 @@ def tolman_lagged_member(base, steps: float):
     """``--tolman-form lagged --tolman-steps N``: C5's s_i follows this step's value through a
     first-order lag of N steps, s <- s + (s_now - s) / N, from the value of i's first step:
     the static curvature's correction without following the mode's own (a probe: N steps is
-    no physical time)."""
+    no physical time). i's first step is the member's: its carried s_i is still UNSET."""
     from crowndemo.core.state import FLUID
 
     class TolmanLaggedStress(_c5_pass_member(base)):
-        def __init__(self, model, grid, coef):
-            super().__init__(model, grid, coef)
-            self.tolman_seen = ti.field(ti.i32, self.state.capacity)
-
         def _c5_pass(self) -> None:
             self._lag(1.0 / steps)
 
@@ -359,11 +355,9 @@ def tolman_lagged_member(base, steps: float):
         def _lag(self, rate: float):
             for at in range(self.state.n[None]):
                 i = self.state.spread(at)
-                if self.state.kind[i] == FLUID:
-                    if self.tolman_seen[i] == 1:
-                        self.tolman_next[i] = self.tolman[i] + rate * (
-                            self.tolman_next[i] - self.tolman[i])
-                    self.tolman_seen[i] = 1
+                if self.state.kind[i] == FLUID and self.tolman[i] > _stress.UNSET:
+                    self.tolman_next[i] = self.tolman[i] + rate * (
+                        self.tolman_next[i] - self.tolman[i])
     return ti.data_oriented(TolmanLaggedStress)
 
 
