@@ -13,6 +13,7 @@ layer does" and after, issue 23), reproducible:
                           [--tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
+                          [--continuity]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
     .venv/bin/python tools/stress_surface_study.py energy R/l0 [--base member] [--relaxed-start P]
@@ -54,6 +55,8 @@ neighbour along the surface (own_pressure_member);
 the particle has, theta = 1 - C |g| l0 (``--theta-slope`` C, fitted on lattice faces);
 ``--surface cumulative`` (``--base member``): after C4 a free-surface particle adds the
 w-weighted mean C4 pressure of its free-surface neighbours outward of it (a third pass);
+``--continuity``: every fluid particle's pressure is the EOS of a number density carried by the
+continuity equation instead of S17's sum (continuity_pressure_member; a third pass);
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -407,6 +410,56 @@ def eos_pressure_member(base, slope: float):
                         self.coef.c2[None] * self.coef.rho[None] * (n / (theta * n0) - 1.0), 0.0)
 
     return EosPressureStress
+
+
+def continuity_pressure_member(base):
+    """``base`` with ``--continuity`` (a probe, tools only): the EOS (S17) of a number density
+    carried by the continuity equation, n_c <- n_c (1 - dt div u*), div u*_i = d / n_i sum_j
+    (u_j - u_i) . r_ij w / r^2 (a third pass, over re), from n0 at each particle's first step,
+    for every fluid particle in place of S17/M3's summed n: a surface particle's missing
+    neighbours no longer read as tension, so the layer within re of the free surface carries
+    the pressure it is compressed to (as weakly compressible SPH's density by the continuity
+    equation); C4 still acts where n_c's pressure is 0. dt = 0 (a frame's refresh) advances
+    nothing."""
+    from crowndemo.core.operators import weight
+    from crowndemo.core.state import FLUID, GONE
+
+    @ti.data_oriented
+    class ContinuityPressureStress(base):
+        def __init__(self, model, grid, coef):
+            super().__init__(model, grid, coef)
+            self.carried_n = self.state.carry("continuity_n", ti.field(float,
+                                                                        self.state.capacity), 0.0)
+
+        def boundary_pressure(self, dt: float = 0.0) -> None:
+            self._continuity(dt)
+            super().boundary_pressure(dt)
+
+        @ti.func
+        def _continuity_pair(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] != GONE:
+                acc += (self.state.vel[j] - self.state.vel[i]).dot(rij) * weight(
+                    ti.sqrt(r2), self.coef.re[None]) / r2
+
+        @ti.kernel
+        def _continuity(self, dt: float):
+            n0, c2, rho = self.coef.n0[None], self.coef.c2[None], self.coef.rho[None]
+            for at in range(self.state.n[None]):
+                i = self.state.spread(at)
+                if self.state.kind[i] == FLUID:
+                    nc = self.carried_n[i]
+                    if nc <= 0.0:
+                        nc = n0
+                    if dt > 0.0:
+                        acc = 0.0
+                        self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                                     self._continuity_pair, acc)
+                        div = self.dim / ti.max(self.state.density[i], 0.5 * n0) * acc
+                        nc *= 1.0 - dt * div
+                        self.carried_n[i] = nc
+                    self.state.pressure[i] = ti.max(c2 * rho * (nc - n0) / n0, 0.0)
+
+    return ContinuityPressureStress
 
 
 def free_marked_member(base):
@@ -1319,6 +1372,9 @@ def main() -> None:
     ap.add_argument("--pressure-filter", action="store_true",
                     help="the pressurised particles' pressure Shepard-filtered every step "
                          "(neighbours_pressure_member, filtered)")
+    ap.add_argument("--continuity", action="store_true",
+                    help="a probe: every fluid particle's pressure from a number density "
+                         "carried by the continuity equation (continuity_pressure_member)")
     ap.add_argument("--amplitude", type=float, default=0.1,
                     help="energy: the mode's relative amplitude (the case's 0.1)")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
@@ -1380,6 +1436,8 @@ def main() -> None:
                          "is the split's unit)")
     if a.pressure_filter:
         member = neighbours_pressure_member(member, filtered=True)
+    if a.continuity:
+        member = continuity_pressure_member(member)
     if a.gradient == "dn":
         from crowndemo.core import pressure
         pressure.gradient_pair = dn_gradient(dim)
