@@ -420,7 +420,7 @@ def continuity_pressure_member(base):
     neighbours no longer read as tension, so the layer within re of the free surface carries
     the pressure it is compressed to (as weakly compressible SPH's density by the continuity
     equation); C4 still acts where n_c's pressure is 0. dt = 0 (a frame's refresh) advances
-    nothing."""
+    nothing. For the drops (no plane floor: its layers are not in the divergence)."""
     from crowndemo.core.operators import weight
     from crowndemo.core.state import FLUID, GONE
 
