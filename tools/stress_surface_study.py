@@ -421,7 +421,7 @@ def continuity_pressure_member(base):
     the pressure it is compressed to (as weakly compressible SPH's density by the continuity
     equation); C4 still acts where n_c's pressure is 0. dt = 0 (a frame's refresh) advances
     nothing. For the drops (no plane floor: its layers are not in the divergence)."""
-    from crowndemo.core.operators import weight
+    from crowndemo.core.operators import gradient_pair, weight
     from crowndemo.core.state import FLUID, GONE
 
     @ti.data_oriented
@@ -438,8 +438,8 @@ def continuity_pressure_member(base):
         @ti.func
         def _continuity_pair(self, i, j, rij, r2, acc: ti.template()):
             if self.state.kind[j] != GONE:
-                acc += (self.state.vel[j] - self.state.vel[i]).dot(rij) * weight(
-                    ti.sqrt(r2), self.coef.re[None]) / r2
+                acc += (self.state.vel[j] - self.state.vel[i]).dot(gradient_pair(   # S11's
+                    1.0, rij, r2, weight(ti.sqrt(r2), self.coef.re[None])))
 
         @ti.kernel
         def _continuity(self, dt: float):
