@@ -71,6 +71,22 @@ def test_plan_covers_resolutions_and_variants():
     assert {v for _, v in p} == {"base", *c.variants}
 
 
+def test_plan_runs_a_variant_at_every_resolution_when_asked():
+    """validate --at-every-resolution: the named variant at each of the plan's resolutions in
+    place of the middle one, the others as before; a case without it is unchanged."""
+    table = cases.all_cases(full=False)
+    c = table["stress-laplace-3d"]
+    p = plan(c, quick=False, variants=True, everywhere=("re=3.1",))
+    assert [s for s, v in p if v == "re=3.1"] == list(c.scales)
+    mid = c.scales[len(c.scales) // 2]
+    assert [(s, v) for s, v in p if v not in ("base", "re=3.1")] == [
+        (mid, v) for v in c.variants if v != "re=3.1"]
+    assert [s for s, v in plan(c, quick=True, variants=True, everywhere=("re=3.1",))
+            if v == "re=3.1"] == list(c.quick)
+    h = table["hydrostatic-2d"]
+    assert plan(h, False, True, ("re=3.1",)) == plan(h, False, True)
+
+
 def test_quick_plan_keeps_every_case_with_one_variant():
     """--quick: every case at its quick resolutions and in one of its own variants (or none,
     where that variant is another case's), at the finest of them; between them every variant

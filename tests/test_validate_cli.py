@@ -44,10 +44,11 @@ def _row(variant="base", error=0.01):
 @pytest.fixture
 def ran(monkeypatch):
     """Fake case runs: the cases asked for, and a Ctrl-C after the first row when told."""
-    calls = {"cases": [], "interrupt": False}
+    calls = {"cases": [], "interrupt": False, "everywhere": []}
 
-    def run_suite(selected, quick, variants, on_row):
+    def run_suite(selected, quick, variants, on_row, everywhere=()):
         calls["cases"].append([c.name for c in selected])
+        calls["everywhere"].append(list(everywhere))
         on_row(_row(error=math.nan))
         if calls["interrupt"]:
             raise KeyboardInterrupt
@@ -92,6 +93,26 @@ def test_validate_runs_a_case_named_twice_once(tmp_path, ran, fake_backend):
             "--out", str(tmp_path)]
     assert main(argv) == 0
     assert ran["cases"] == [["laplace-2d", "hydrostatic-2d"]]
+
+
+def test_validate_at_every_resolution_takes_a_variant_of_the_cases(tmp_path, capsys, ran,
+                                                                    fake_backend):
+    """--at-every-resolution names a settings variant of the cases selected (refused before
+    the backend starts otherwise, naming the allowed ones), not with --no-variants; the
+    suite gets it."""
+    assert main(["validate", "stress-laplace-3d", "--at-every-resolution", "re=3.1",
+                 "--out", str(tmp_path)]) == 0
+    assert ran["everywhere"] == [["re=3.1"]]
+    capsys.readouterr()
+    assert main(["validate", "hydrostatic-2d", "--at-every-resolution", "re=3.1",
+                 "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "--at-every-resolution re=3.1: not a variant of the cases selected; allowed: " \
+        "f64, safety/2" in err and err.count("error") == 1
+    assert main(["validate", "stress-laplace-3d", "--no-variants", "--at-every-resolution",
+                 "re=3.1", "--out", str(tmp_path)]) == 2
+    assert "--no-variants runs none" in capsys.readouterr().err
+    assert len(ran["everywhere"]) == 1
 
 
 def test_quick_leaves_out_the_costly_cases_unless_named():
@@ -183,7 +204,7 @@ def test_validate_ctrl_c_before_any_row_replaces_the_older_report(tmp_path, caps
     (tmp_path / "validation.md").write_text("an earlier run\n| base | 1 |")
     (tmp_path / "validation.csv").write_text("an earlier run")
 
-    def run_suite(selected, quick, variants, on_row):
+    def run_suite(selected, quick, variants, on_row, everywhere=()):
         raise KeyboardInterrupt
     monkeypatch.setattr(runner, "run_suite", run_suite)
     assert main(["validate", "hydrostatic-2d", "--out", str(tmp_path)]) == 130

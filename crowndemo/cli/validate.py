@@ -26,6 +26,8 @@ examples:
   crowndemo validate verdicts --quality draft    # crown or not, the seed's four runs
   crowndemo validate --list
   crowndemo validate --record                    # also rewrite VALIDATION.md
+  crowndemo validate stress-laplace-3d stress-drop-oscillation-3d --at-every-resolution re=3.1
+                                                 # the stress drops at both neighbourhoods
 
 Cases: hydrostatic, dam-break, drop-oscillation, laplace, shear-wave, sliding-layer,
 stress-laplace, stress-drop-oscillation, stress-free-drop (each -2d and -3d),
@@ -33,7 +35,8 @@ crown-base-quick, crown-base-3m-drop; groups: stability, verdicts. The stress- c
 surface-stress model (method.md §4c) with the sum gradient form, their 3D drops started off
 the lattice (variant lattice: on it), at re = 2.1 l0 (variant re=3.1: the member's wider
 neighbourhood). Each case runs at three resolutions in the base settings and, at the middle
-one, in its settings variants (--list says which case runs which):
+one, in its settings variants (--list says which case runs which; --at-every-resolution
+VARIANT runs one at every resolution):
   {variants}
 --quick runs each case at one coarse resolution and in one of its variants (--list names
 it), the stability suite to 0.4 ms, and leaves out crown-base-3m-drop, stress-free-drop-3d and
@@ -119,6 +122,23 @@ def _names(args, table) -> list:
     return names
 
 
+def _check_everywhere(args, selected) -> None:
+    """--at-every-resolution names variants of the selected cases, and asks for variants
+    (UsageError otherwise, before any kernel runs)."""
+    from ..validate.runner import variant_names
+    if not args.at_every_resolution:
+        return
+    if args.no_variants:
+        raise UsageError("--at-every-resolution runs a settings variant; --no-variants "
+                         "runs none: give one or the other")
+    allowed = variant_names(selected)
+    unknown = [v for v in args.at_every_resolution if v not in allowed]
+    if unknown:
+        raise UsageError(f"--at-every-resolution {unknown[0]}: not a variant of the cases "
+                         f"selected; allowed: {', '.join(allowed) or 'none'} (see "
+                         f"'{PROG} validate --list')")
+
+
 def _run(args, names, table, found, say) -> None:
     """Run the selected cases and groups; every finished row goes into ``found`` at once, so
     that an interrupted run keeps it."""
@@ -144,7 +164,7 @@ def _run(args, names, table, found, say) -> None:
     if selected:
         say(f"{PROG}: validating {len(selected)} case(s){' (quick)' if args.quick else ''}")
         runner.run_suite(selected, quick=args.quick, variants=not args.no_variants,
-                         on_row=row_line)
+                         on_row=row_line, everywhere=args.at_every_resolution)
     if "stability" in names:
         say(f"{PROG}: stability suite")
         stability.run_suite(full=not args.quick, on_row=stab_line)
@@ -181,6 +201,7 @@ def _validate(args, argv) -> int:
     if args.list:
         return _list(table, args.cases, args.json)
     names = _names(args, table)
+    _check_everywhere(args, [table[n] for n in names if n in table])
     out = os.path.join(repo_root(), "reports") if args.out is None else args.out
     require_folder("--out", out)
     if args.quick and args.fast_compile is None and "CROWNDEMO_FAST_COMPILE" not in os.environ:
@@ -312,6 +333,10 @@ def register(sub, common) -> None:
                         "$CROWNDEMO_FAST_COMPILE is set")
     p.add_argument("--no-variants", action="store_true",
                    help="base settings only (no {variants})")
+    p.add_argument("--at-every-resolution", action="append", default=[], metavar="VARIANT",
+                   help="run this settings variant at every resolution of the cases that have "
+                        "it, not only the middle one (repeatable; e.g. re=3.1: the stress "
+                        "drops at the member's wider neighbourhood)")
     add_quality(p, "draft", "quality of the verdict runs")
     p.add_argument("--out", type=path_argument, metavar="DIR", default=None,
                    help="folder for the reports (default: reports/ at the repository root)")

@@ -63,25 +63,31 @@ def variant_names(cases: Iterable[Case]) -> List[str]:
     return list(dict.fromkeys(v for c in cases for v in c.variants))
 
 
-def plan(case: Case, quick: bool, variants: bool) -> List[tuple]:
+def plan(case: Case, quick: bool, variants: bool, everywhere: Iterable[str] = ()) -> List[tuple]:
     """(scale, variant) pairs: every resolution in the base settings, and each variant at the
     middle resolution; a quick plan: the quick resolutions, and the case's one quick variant
-    at the finest of them."""
+    at the finest of them. The case's variants named in ``everywhere`` run at every
+    resolution of the plan instead (validate --at-every-resolution)."""
     scales = case.quick if quick else case.scales
     out = [(s, "base") for s in scales]
+    wide = [v for v in case.variants if v in set(everywhere)]
     if variants:
         mid = scales[len(scales) // 2] if not quick else scales[-1]
-        out += [(mid, v) for v in (case.quick_variants if quick else case.variants)]
+        out += [(mid, v) for v in (case.quick_variants if quick else case.variants)
+                if v not in wide]
+    out += [(s, v) for v in wide for s in scales]
     return out
 
 
 def run_suite(cases: Iterable[Case], quick: bool = False, variants: bool = True,
-              on_row: Optional[Callable[[Row], None]] = None) -> List[Row]:
-    """Every case's plan; the f64 runs last, after one switch of the backend's precision.
+              on_row: Optional[Callable[[Row], None]] = None,
+              everywhere: Iterable[str] = ()) -> List[Row]:
+    """Every case's plan (``everywhere``: variants run at every resolution, ``plan``); the
+    f64 runs last, after one switch of the backend's precision.
     Runs of the same compiled model share one simulator where the scene fits in it
     (cases.sharing): only the first of them, and a bigger scene, compile the kernels."""
     be = backend.current()
-    jobs = [(c, s, v) for c in cases for s, v in plan(c, quick, variants)]
+    jobs = [(c, s, v) for c in cases for s, v in plan(c, quick, variants, everywhere)]
     jobs.sort(key=lambda j: j[2] == "f64")
     rows: List[Row] = []
     kernels = Session()
