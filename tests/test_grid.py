@@ -388,7 +388,8 @@ def test_wide_walk_matches_brute_force(dim, reach, max_cells):
     """The wide walk (``for_each_wide``) of a grid made for the surface stress's pair support
     H = 3 l0 (Model.wide_walk = 3 / 2.1): every pair within H, none beyond, with the cell side
     re/k and grown under a small cell limit; and the walk at re on the same grid is unchanged."""
-    from crowndemo.core.params import STRESS_PAIR_SUPPORT
+    from crowndemo.core.params import stress_pair_support
+    STRESS_PAIR_SUPPORT = stress_pair_support(dim, RE_RATIO)
     physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0728,
                       gravity=0.0)
     sim = Simulator(physics, Numerics(cells_per_re=reach, surface_tension="stress"), CAPACITY,

@@ -1,6 +1,6 @@
 """The stress member's neighbourhoods (params.STRESS_NEIGHBOURHOODS, method.md §4c): the seed's
-re = 2.1 l0 and the wider 3.1 l0, each with its measured constants (C4's factor F, C5's delta),
-and any other re refused before a kernel runs.
+re = 2.1 l0 and the wider 3.1 l0, each with its measured constants (C3's pair support H, C4's
+factor F, C5's delta), and any other re refused before a kernel runs.
 
 Expected values: F is the flat lattice face's balance, the factor at which C4's pressure
 F rho l0 a equals the push the sum form (S11 with P_i + P_j, M2) gives a uniform pressure on
@@ -42,18 +42,49 @@ def test_c4_factor_is_the_flat_faces_balance(dim, re_ratio):
     expected = face_push_factor(dim, re_ratio)
     assert face_balance_factor(dim, re_ratio) == pytest.approx(expected, rel=1e-12)
     factor, _ = stress_constants(dim, re_ratio)
-    if re_ratio == 3.1:          # the wider neighbourhood takes the balance itself
+    if re_ratio == 3.1 and dim == 2:      # the wider neighbourhood's 2D takes the balance
         assert factor == pytest.approx(expected, rel=1e-12)
-    else:                        # the seed's takes 1, the balance to 1.6 %
-        assert factor == 1.0 and abs(expected - 1.0) < 0.016
+    else:    # the seed's takes 1, the balance to 1.6 %; 3.1 l0's 3D takes 1, measured
+        assert factor == 1.0 and (re_ratio == 3.1 or abs(expected - 1.0) < 0.016)
 
 
-def test_deltas_of_each_neighbourhood():
-    """C5's delta (l0): 0.80 in 3D at both; in 2D 0 (compiled out) at 2.1 l0 and 0.9 at 3.1 l0
-    (VALIDATION.md "re = 3.1 l0 completed")."""
+def test_deltas_and_pair_supports_of_each_neighbourhood():
+    """C5's delta (l0): in 3D 0.80 at 2.1 l0, 1.25 at 3.1 l0; in 2D 0 (compiled out) at 2.1 l0
+    and 0.9 at 3.1 l0 (VALIDATION.md "re = 3.1 l0 completed", "re = 3.1 l0 with C3's pairs to
+    4.1 l0"); C3's pair support H: 3 l0 at 2.1 l0, in 3D re + l0 at 3.1 l0 (2D: 3 l0), and the
+    seed's for an re without constants (the other members compile as at 2.1 l0). The grid's
+    wide walk reaches H."""
+    from crowndemo.core.params import stress_pair_support
     assert [stress_constants(d, 2.1)[1] for d in (2, 3)] == [0.0, 0.80]
-    assert [stress_constants(d, 3.1)[1] for d in (2, 3)] == [0.9, 0.80]
+    assert [stress_constants(d, 3.1)[1] for d in (2, 3)] == [0.9, 1.25]
     assert sorted(STRESS_NEIGHBOURHOODS) == [2.1, 3.1]
+    assert [stress_pair_support(3, x) for x in (2.1, 3.1, 2.5)] == [3.0, 4.1, 3.0]
+    assert [stress_pair_support(2, x) for x in (2.1, 3.1, 2.5)] == [3.0, 3.0, 3.0]
+    stress = Numerics(surface_tension="stress", pressure_gradient="sum")
+    for dim, re_ratio, H in ((2, 2.1, 3.0), (3, 2.1, 3.0), (2, 3.1, 3.0), (3, 3.1, 4.1)):
+        ph = Physics(dim=dim, l0=1e-4, v_max=1.0, re_ratio=re_ratio)
+        assert Model.of(ph, stress).wide_walk == pytest.approx(max(1.0, H / re_ratio))
+
+
+def test_a_3d_simulator_at_the_wider_neighbourhood_walks_and_weighs_to_its_pair_support():
+    """A 3D stress simulator at re = 3.1 l0: the grid's wide walk and C3's pair weight reach
+    H = 4.1 l0 (the member reads H at construction; its kernels compile with it), and its
+    K_d is the lattice normalisation over that support (a linear field's gradient exact)."""
+    from crowndemo.core import Simulator
+    from crowndemo.core.lattice import (lattice_offsets, stress_gradient_norm,
+                                        stress_pair_kernel)
+    l0 = 1e-4
+    ph = Physics(dim=3, l0=l0, v_max=1.0, re_ratio=3.1, nu=1e-6, sigma=SIGMA, gravity=0.0)
+    sim = Simulator(ph, Numerics(surface_tension="stress", pressure_gradient="sum"), 800)
+    assert sim.grid.wide == pytest.approx(4.1 / 3.1)
+    assert sim.surface_tension.pair_support == 4.1
+    h = 4.1 * l0
+    offs = lattice_offsets(3, l0, h)
+    Kd = stress_gradient_norm(3, l0, 3.1 * l0, stress_pair_kernel, h)
+    grad = Kd * (offs * (offs @ np.array([1.0, 2.0, 3.0]))[:, None]
+                 * stress_pair_kernel(np.linalg.norm(offs, axis=1), h)[:, None]).sum(axis=0)
+    np.testing.assert_allclose(grad, [1.0, 2.0, 3.0], rtol=1e-12)
+    assert sim.lattice.stress_Kd == pytest.approx(Kd, rel=1e-12)
 
 
 def test_model_refuses_the_stress_member_at_another_re():
@@ -91,6 +122,7 @@ def test_info_gives_the_wider_neighbourhoods_constants(capsys):
     st = json.loads(capsys.readouterr().out)["surface_tension"]
     assert st["constants"]["F"] == pytest.approx(face_push_factor(2, 3.1), rel=1e-12)
     assert st["constants"]["delta_l0"] == 0.9
+    assert st["constants"]["H_l0"] == 3.0         # 4.1 l0 in 3D only
     # C5's lag (method.md §4c), wherever C5 is on
     assert st["constants"]["lag_capillary_times"] == STRESS_TOLMAN_LAG
     # the run time's costs are measured at 2.1 l0: info says so, with the lattice's neighbours

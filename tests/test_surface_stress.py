@@ -32,7 +32,8 @@ def test_colour_gradient_of_a_step_integrates_to_one_half(dim):
     assert float(g.sum()) * L0 == pytest.approx(0.5, rel=1e-12)
     # the gradient of a linear field is exact with K (C3's normalisation, also for f_d, over
     # its support H = 3 l0)
-    for kernel, h in ((stress_kernel, 2.1 * L0), (stress_pair_kernel, stress_pair_support(L0))):
+    for kernel, h in ((stress_kernel, 2.1 * L0),
+                      (stress_pair_kernel, stress_pair_support(dim, L0, 2.1))):
         offs = lattice_offsets(dim, L0, h)
         K = stress_gradient_norm(dim, L0, 2.1 * L0, kernel, h)
         grad = K * (offs * (offs @ np.arange(1.0, dim + 1))[:, None]
@@ -262,7 +263,7 @@ def test_plane_floor_is_no_free_surface(dim):
     whole lattice."""
     from crowndemo.core.lattice import wall_layers
     from crowndemo.core.plane_floor import FLOOR_C, FLOOR_D, floor_tables
-    re, h = 2.1 * L0, stress_pair_support(L0)
+    re, h = 2.1 * L0, stress_pair_support(dim, L0, 2.1)
     # 111 samples from -l0/4 to H - l0/2 = 2.5 l0: every 0.025 l0, s = l0/2 and 3 l0/2 on it
     s0, ds, table = floor_tables(dim, L0, re, wall_layers(2.1), samples=111, reach=h)
     for column, kernel, reach in ((FLOOR_C, stress_kernel, re), (FLOOR_D, stress_pair_kernel, h)):

@@ -90,13 +90,16 @@ speed F times drop_sound_speed's (the compression under the cohesion 1 % / F^2);
 ``--re-ratio X``: every drop's re = X l0 (the cases' 2.1; tools/mode_power_study.py), with
 the member's constants there (params.STRESS_NEIGHBOURHOODS: since 2026-12-07 at 3.1 l0 F from
 the lattice and delta 0.9 in 2D, so the 3.1 l0 rows before, with F = 1, take ``--c4-factor 1``
-and in 2D ``--tolman 0``), elsewhere the seed neighbourhood's (admit_neighbourhood);
+and in 2D ``--tolman 0``; since 2026-12-07's third session in 3D H = 4.1, F = 1 and delta
+1.25, so the 3D rows at 3.1 l0 before take ``--pair-support 3 --c4-factor lattice --tolman
+0.8`` and the 2D rows ``--pair-support 3``), elsewhere the seed neighbourhood's
+(admit_neighbourhood);
 ``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
 place of the neighbourhood's F; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat
 lattice face's balance (lattice.face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1
 l0);
-``--pair-support H``: C3's pair support H l0 (params.STRESS_PAIR_SUPPORT, the member's 3)
-in place of 3, the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
+``--pair-support H``: C3's pair support H l0 in place of the neighbourhood's
+(params.STRESS_NEIGHBOURHOODS: 3 at 2.1 l0, 4.1 at 3.1 l0), the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
 and re = 4.0 l0": re + l0 holds the surface at re = 4.0 l0);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
@@ -243,7 +246,8 @@ def admit_neighbourhood(re_over_l0: float) -> None:
         params.stress_neighbourhood(re_over_l0)
     except params.ParameterError:
         seed = params.STRESS_NEIGHBOURHOODS[2.1]
-        params.STRESS_NEIGHBOURHOODS[re_over_l0] = {"c4_factor": 1.0,
+        params.STRESS_NEIGHBOURHOODS[re_over_l0] = {"pair_support": dict(seed["pair_support"]),
+                                                    "c4_factor": {2: 1.0, 3: 1.0},
                                                     "tolman": dict(seed["tolman"])}
 
 
@@ -851,7 +855,7 @@ def kernel_ratio(dim: int, name: str) -> float:
     from crowndemo.core import lattice
     Kd, a = pair_normalisers(dim, name)
     return Kd * a / (lattice.stress_gradient_norm(dim, 1.0, 2.1, lattice.stress_pair_kernel,
-                                                  lattice.stress_pair_support(1.0))
+                                                  lattice.stress_pair_support(dim, 1.0, 2.1))
                      * lattice.stress_normaliser(dim, 1.0, 2.1))
 
 
@@ -1355,7 +1359,8 @@ def main() -> None:
     ap.add_argument("--re-ratio", type=float, default=None,
                     help="every drop's re / l0 (the cases' 2.1)")
     ap.add_argument("--pair-support", type=float, default=None, metavar="H",
-                    help="C3's pair support in l0 (params.STRESS_PAIR_SUPPORT, the member's 3)")
+                    help="C3's pair support in l0 (the neighbourhood's unless given: "
+                    "params.STRESS_NEIGHBOURHOODS, 3 at 2.1 l0, 4.1 at 3.1 l0)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",
@@ -1392,7 +1397,8 @@ def main() -> None:
     from crowndemo.core import Numerics
     if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
         import crowndemo.core.params as params_module
-        params_module.STRESS_PAIR_SUPPORT = a.pair_support
+        for own in params_module.STRESS_NEIGHBOURHOODS.values():
+            own["pair_support"] = {2: a.pair_support, 3: a.pair_support}
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     dim = (int(a.args[0]) if a.what == "drop" else 3 if a.what == "energy"

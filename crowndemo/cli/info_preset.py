@@ -20,15 +20,16 @@ SURFACE_TENSION_WHAT = {
 
 def surface_tension_summary(model: str, lat, sigma: float) -> dict:
     """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3;
-    the neighbourhood's C4 factor F and C5's delta and lag where delta is not 0)."""
+    the neighbourhood's C3 pair support H, C4 factor F and C5's delta and lag where delta is
+    not 0)."""
     if model == "potential":
         constants = {"C": lat.C}
     elif model == "stress":
         from ..core.lattice import stress_constants
-        from ..core.params import STRESS_TOLMAN_LAG
+        from ..core.params import STRESS_TOLMAN_LAG, stress_pair_support
         factor, delta = stress_constants(lat.dim, lat.re / lat.l0)
         constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd,
-                     "F": factor}
+                     "H_l0": stress_pair_support(lat.dim, lat.re / lat.l0), "F": factor}
         if delta > 0:      # C5's curvature correction (3D; 2D at 3.1 l0)
             constants["delta_l0"] = delta
             constants["lag_capillary_times"] = STRESS_TOLMAN_LAG
@@ -196,8 +197,8 @@ def info_preset(args) -> int:
           f"{f['lambda0_over_l0_sq']:.6g} l0^2), C {f['C']:.6g} {c_unit}, mass {f['mass']:.6g} "
           f"{f['mass_unit']}")
     st = f["surface_tension"]
-    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "delta_l0": " l0",
-             "lag_capillary_times": " capillary times"}
+    units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "H_l0": " l0",
+             "delta_l0": " l0", "lag_capillary_times": " capillary times"}
     print(f"  tension     {st['model']}: {st['what']}" + "".join(
         f"; {k.split('_1_')[0].removesuffix('_l0').removesuffix('_capillary_times')} "
         f"{v:.6g}{units.get(k, '')}"

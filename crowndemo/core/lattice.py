@@ -85,10 +85,11 @@ def stress_kernel(r: np.ndarray, re: float) -> np.ndarray:
     return np.where(r < re, (1.0 - np.minimum(r, re) / re) ** 3, 0.0)
 
 
-def stress_pair_support(l0: float) -> float:
-    """H = params.STRESS_PAIR_SUPPORT l0 = 3 l0: the support of the divergence's pair weight
-    (C3); read at each call, so a study that sets the one constant moves every reader."""
-    return params.STRESS_PAIR_SUPPORT * l0
+def stress_pair_support(dim: int, l0: float, re_ratio: float) -> float:
+    """H: the support of the divergence's pair weight (C3) in ``dim`` at re = ``re_ratio`` l0,
+    its neighbourhood's (params.STRESS_NEIGHBOURHOODS: 3 l0, or 4.1 l0 in 3D at 3.1 l0); read
+    at each call, so a study that sets it moves every reader."""
+    return params.stress_pair_support(dim, re_ratio) * l0
 
 
 def stress_pair_kernel(r: np.ndarray, h: float) -> np.ndarray:
@@ -135,7 +136,7 @@ def stress_normaliser(dim: int, l0: float, re: float) -> float:
     of the divergence (C3) transmits, per unit length of the surface (and depth in 2D),
     a sigma l0 K_d sum_k sum_{r_x > 0} r_x^2 f_d(r) (|g_k| + |g_k'|) (j = i + r in layer k',
     |r| < H); a makes that sigma. Dimensionless."""
-    h = stress_pair_support(l0)
+    h = stress_pair_support(dim, l0, re / l0)
     offs = lattice_offsets(dim, l0, h)
     f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
     K = stress_gradient_norm(dim, l0, re, stress_pair_kernel, h)
@@ -168,7 +169,7 @@ def stress_constants(dim: int, re_ratio: float) -> tuple[float, float]:
     """The stress member's (C4's F, C5's delta in l0) at ``re_ratio``
     (params.STRESS_NEIGHBOURHOODS; a ParameterError for a neighbourhood it has none for)."""
     own = STRESS_NEIGHBOURHOODS[stress_neighbourhood(re_ratio)]
-    factor = own["c4_factor"]
+    factor = own["c4_factor"][dim]
     if factor == "lattice":
         factor = face_balance_factor(dim, re_ratio)
     return float(factor), float(own["tolman"][dim])
@@ -200,7 +201,7 @@ class LatticeConstants:
                    rho * l0 ** dim, stress_normaliser(dim, l0, re),
                    stress_gradient_norm(dim, l0, re),
                    stress_gradient_norm(dim, l0, re, stress_pair_kernel,
-                                        stress_pair_support(l0)))
+                                        stress_pair_support(dim, l0, re_ratio)))
 
 
 def lattice_cohesion_pressure(dim: int, l0: float, re: float, C: float) -> float:

@@ -24,31 +24,39 @@ VISCOSITY_MODELS = ("laplacian", "central")
 # nu k^2; on the lattice the largest eigenvalue of its pair sum is 2.80 (3D) / 2.87 (2D)
 # times the Laplacian's (tests/test_viscosity.py)
 VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
-# the surface stress's divergence pair kernel reaches STRESS_PAIR_SUPPORT l0 (method.md C3):
-# beyond re = 2.1 l0, so its walk is the grid's wide one (grid.py)
-STRESS_PAIR_SUPPORT = 3.0
 # the surface stress's neighbourhoods (method.md §4c), re/l0 -> its measured constants:
-# - "c4_factor": C4's F, the free surface's own normal stress F rho l0 a.g/|g|; "lattice": the
-#   flat lattice face's balance n0/(2 d G l0) at that re (lattice.face_balance_factor: 1.160 /
-#   1.187 in 2D / 3D at 3.1 l0); 1 at 2.1 l0, where the balance is 1.016 / 1.011;
+# - "pair_support": H/l0 per dimension, the reach of C3's divergence pair kernel: beyond re,
+#   so its walk is the grid's wide one (grid.py); 3 l0 at 2.1 l0; at 3.1 l0 4.1 l0 (re + l0)
+#   in 3D, so that C3's pairs cover the colour gradient's whole neighbourhood, and 3 l0 in 2D,
+#   where 4.1 l0 read the mode 6.4 % fast (VALIDATION.md, "re = 3.1 l0 with C3's pairs to
+#   4.1 l0");
+# - "c4_factor": C4's F, the free surface's own normal stress F rho l0 a.g/|g|, per dimension;
+#   "lattice": the flat lattice face's balance n0/(2 d G l0) at that re
+#   (lattice.face_balance_factor: 1.160 / 1.187 in 2D / 3D at 3.1 l0); 1 at 2.1 l0, where the
+#   balance is 1.016 / 1.011, and in 3D at 3.1 l0, where the balance read the mode 4-5 % slow;
 # - "tolman": C5's curvature correction sigma (1 - delta H), delta in l0 per dimension; the
 #   surface of tension sits inside the liquid's surface (VALIDATION.md, "The curvature
-#   correction"); 0 compiles it out. 0.80 in 3D: the value at which the resting drop's error
-#   falls with resolution (VALIDATION.md, "C5's H from the normals' tangential change"; 0.92,
-#   set at R/l0 = 12 alone, over-corrected at 16); 0.9 in 2D at 3.1 l0, where without it the
-#   drop read high ("re = 3.1 l0 completed").
+#   correction"); 0 compiles it out. 0.80 in 3D at 2.1 l0: the value at which the resting
+#   drop's error falls with resolution (VALIDATION.md, "C5's H from the normals' tangential
+#   change"; 0.92, set at R/l0 = 12 alone, over-corrected at 16); at 3.1 l0 0.9 in 2D, where
+#   without it the drop read high ("re = 3.1 l0 completed"), and 1.25 in 3D, where C3's wider
+#   pairs pull deeper.
 # 2.1 l0 is the seed's neighbourhood, the crowns'; at 3.1 l0 the 3D drops' Laplace and mode-2
-# errors fall with resolution and the decay is 1.2-1.3 times Lamb's rate with C5 lagged,
-# 1.5-1.9 at 2.1 l0 (a 3D particle has 122 lattice neighbours within re against 32; the 3D
-# drop cases ran 1.8-2.2 times as long). The constants are measured, not derived: another
-# re is refused.
+# frequency errors fall with resolution and the decay is 1.0-1.16 times Lamb's rate at R/l0 =
+# 10-16 (VALIDATION.md, "re = 3.1 l0 with C3's pairs to 4.1 l0"; 1.17-1.32 with H = 3 l0),
+# 1.5-1.9 times it at 2.1 l0 (a 3D particle has 122 lattice neighbours within re against 32). The constants are measured, not derived: another re is
+# refused.
 # C5's s_i follows its step's value through a first-order lag of this many capillary times
 # sqrt(rho / (sigma |H|^3)) (about 1.6 periods of mode 2 of a drop of radius 1/|H|; method.md
 # §4c): a tension that followed the mode's own bending damped a 3D drop's oscillation
 # (VALIDATION.md, "C5's own damping", "C5 lagged in the surface's capillary time")
 STRESS_TOLMAN_LAG = 3.5
-STRESS_NEIGHBOURHOODS = {2.1: {"c4_factor": 1.0, "tolman": {2: 0.0, 3: 0.80}},
-                         3.1: {"c4_factor": "lattice", "tolman": {2: 0.9, 3: 0.80}}}
+STRESS_NEIGHBOURHOODS = {2.1: {"pair_support": {2: 3.0, 3: 3.0}, "c4_factor": {2: 1.0, 3: 1.0},
+                               "tolman": {2: 0.0, 3: 0.80}},
+                         3.1: {"pair_support": {2: 3.0, 3: 4.1},
+                               "c4_factor": {2: "lattice", 3: 1.0},
+                               "tolman": {2: 0.9, 3: 1.25}}}
+SEED_NEIGHBOURHOOD = 2.1
 
 
 def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
@@ -59,6 +67,16 @@ def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
             return key
     raise ParameterError("re_ratio", re_ratio, " or ".join(f"{k:g}" for k in STRESS_NEIGHBOURHOODS)
                          + " with surface_tension: stress", source)
+
+
+def stress_pair_support(dim: int, re_ratio: float) -> float:
+    """C3's pair support H/l0 in ``dim`` at ``re_ratio``: its neighbourhood's, or the seed
+    neighbourhood's where it has none (the other members, which compile as at 2.1 l0)."""
+    for key, own in STRESS_NEIGHBOURHOODS.items():
+        if _finite(re_ratio) and abs(re_ratio - key) < 1e-9:
+            return float(own["pair_support"][dim])
+    return float(STRESS_NEIGHBOURHOODS[SEED_NEIGHBOURHOOD]["pair_support"][dim])
+
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
@@ -229,7 +247,9 @@ class Model:
                    numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
                    numerics.predictor_list and numerics.neighbour_list,
                    numerics.surface_tension,
-                   max(1.0, STRESS_PAIR_SUPPORT / physics.re_ratio) if stress else 1.0,
+                   max(1.0, stress_pair_support(physics.dim, physics.re_ratio)
+                       / physics.re_ratio)
+                   if stress else 1.0,
                    numerics.viscosity,
                    stress_neighbourhood(physics.re_ratio) if stress else Physics.re_ratio)
 

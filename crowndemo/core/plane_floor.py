@@ -49,7 +49,7 @@ def floor_tables(dim: int, l0: float, re: float, layers: int, samples: int = SAM
     to reach - l0/2 (beyond, no floor point is within reach). ``reach``: the widest walk, re
     (the default) or, for the surface stress, its pair support H (Model.wide_walk): d_floor
     is summed within H but tabulated only as far as the walks reach."""
-    h = stress_pair_support(l0)
+    h = stress_pair_support(dim, l0, re / l0)
     reach = re if reach is None else reach
     s0, s1 = -0.25 * l0, reach - 0.5 * l0
     ds = (s1 - s0) / (samples - 1)

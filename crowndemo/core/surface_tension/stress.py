@@ -73,9 +73,10 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    tension's static offset alone (VALIDATION.md, "C5's own damping", "C5 lagged in the
    surface's capillary time").
 
-F and delta are the neighbourhood's (params.STRESS_NEIGHBOURHOODS: re = 2.1 l0, the seed's, or
-3.1 l0, where the 3D drops' errors fall with resolution; another re is refused, its constants
-unmeasured). The acceleration is applied in the corrector with the pressure gradient
+F, delta and C3's pair support H are the neighbourhood's (params.STRESS_NEIGHBOURHOODS: re =
+2.1 l0, the seed's, H = 3 l0, or 3.1 l0, H = 4.1 l0 in 3D, where the 3D drops' errors fall with
+resolution and their decay is 1.0-1.16 times Lamb's rate; another re is refused, its
+constants unmeasured). The acceleration is applied in the corrector with the pressure gradient
 (S18-S20), at r*.
 ``_pair_weight`` and ``_surface_pressure`` are the member's two choices (C3's f_d, C4), each a
 method, so a study (tools/stress_surface_study.py) can swap one without restating a pass.
@@ -172,6 +173,7 @@ class StressTension:
         self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
         self.floor = None        # the analytic plane floor, where the model has one
         factor, delta = stress_constants(self.dim, model.stress_re_ratio)
+        self.pair_support = params.stress_pair_support(self.dim, model.stress_re_ratio)   # H / l0 (C3)
         self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
         # C5: sigma (1 - delta H), delta in l0; s_i lagged in capillary time (_followed)
         self.delta = delta if self.tolman_delta is None else float(self.tolman_delta)
@@ -243,7 +245,7 @@ class StressTension:
     def _pair_weight(self, r):
         """f_d(r) with its core (C3)."""
         l0 = self.coef.l0[None]
-        return stress_pair_kernel(r, params.STRESS_PAIR_SUPPORT * l0, l0)   # H (compile time)
+        return stress_pair_kernel(r, self.pair_support * l0, l0)   # H (compile time)
 
     @ti.func
     def _pair_tension(self, i, j, gi, gj, rij):
@@ -301,7 +303,7 @@ class StressTension:
         g g^T/|g|) (C2), T_j = 0 for walls and dummies (the plane floor's layers: d_floor)."""
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
             self.coef.rho[None])
-        reach2 = (params.STRESS_PAIR_SUPPORT * self.coef.l0[None]) ** 2    # H^2: the wide walk
+        reach2 = (self.pair_support * self.coef.l0[None]) ** 2    # H^2: the wide walk
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
             s_next = 1.0
