@@ -389,19 +389,19 @@ def test_wide_walk_matches_brute_force(dim, reach, max_cells):
     H = 3 l0 (Model.wide_walk = 3 / 2.1): every pair within H, none beyond, with the cell side
     re/k and grown under a small cell limit; and the walk at re on the same grid is unchanged."""
     from crowndemo.core.params import stress_pair_support
-    STRESS_PAIR_SUPPORT = stress_pair_support(dim, RE_RATIO)
+    support = stress_pair_support(dim, RE_RATIO)
     physics = Physics(dim=dim, l0=L0, v_max=1.0, re_ratio=RE_RATIO, nu=0.0, sigma=0.0728,
                       gravity=0.0)
     sim = Simulator(physics, Numerics(cells_per_re=reach, surface_tension="stress"), CAPACITY,
                     BIG[dim] if max_cells == "big" else SMALL)
-    assert sim.grid.wide == pytest.approx(STRESS_PAIR_SUPPORT / RE_RATIO)
+    assert sim.grid.wide == pytest.approx(support / RE_RATIO)
     pos = random_cloud(dim, 90 + 10 * dim + reach, n_box=CLOUD[dim]["n_box"] // 3,
                        box_re=CLOUD[dim]["box_re"], far_re=40.0)
     kind = np.full(len(pos), FLUID, dtype=np.int32)
     sim.load(pos, np.zeros_like(pos), kind)
     sim.grid.build(RE)
     check_against_brute_force(sim, Walker(sim, wide=True), as_loaded(sim), kind,
-                              radius=STRESS_PAIR_SUPPORT * L0)
+                              radius=support * L0)
     check_against_brute_force(sim, Walker(sim), as_loaded(sim), kind)
 
 
