@@ -20,7 +20,8 @@ speed too, as the case's rule sets it, and Lamb's rate does not); --re-ratio X: 
 2.1 l0's delta where it has none); --c4-factor F|lattice: C4's factor F in place of the
 neighbourhood's, or the flat lattice face's balance at the run's re
 (tools/stress_surface_study.py's option); --pair-support H: C3's pair support H l0 in place
-of the neighbourhood's (params.STRESS_NEIGHBOURHOODS: 3 at 2.1 l0, 4.1 at 3.1 l0); --tolman DELTA: C5's delta in place of the
+of the neighbourhood's (params.STRESS_NEIGHBOURHOODS: 3, or 4.1 in 3D at 3.1 l0); --tolman
+DELTA: C5's delta in place of the
 neighbourhood's (0 compiles C5 out); --tolman-form / --tolman-steps: C5's probes (s_i on
 i's whole pull, smoothed over the surface, or lagged N steps); --tolman-lag K: the member's
 lag of C5 in capillary times (0: none, the member to 2026-12-07); all as in
@@ -137,7 +138,7 @@ def main() -> None:
                     help="C4's factor (the member's 1), or 'lattice': the face balance at re")
     ap.add_argument("--pair-support", type=float, default=None, metavar="H",
                     help="C3's pair support in l0 (the neighbourhood's unless given: "
-                    "params.STRESS_NEIGHBOURHOODS, 3 at 2.1 l0, 4.1 at 3.1 l0)")
+                    "params.STRESS_NEIGHBOURHOODS: 3, or 4.1 in 3D at 3.1 l0)")
     ap.add_argument("--tolman", type=float, default=None, metavar="DELTA",
                     help="C5's delta in l0 (the neighbourhood's unless given; 0: C5 off)")
     ap.add_argument("--tolman-form", choices=("pair", "particle", "smoothed", "lagged"),

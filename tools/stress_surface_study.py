@@ -99,8 +99,9 @@ place of the neighbourhood's F; ``lattice``: F = n0/(2 d G l0) at the run's re, 
 lattice face's balance (lattice.face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1
 l0);
 ``--pair-support H``: C3's pair support H l0 in place of the neighbourhood's
-(params.STRESS_NEIGHBOURHOODS: 3 at 2.1 l0, 4.1 at 3.1 l0), the lattice normalisers following it (VALIDATION.md "re = 3.1 l0 completed,
-and re = 4.0 l0": re + l0 holds the surface at re = 4.0 l0);
+(params.STRESS_NEIGHBOURHOODS: 3, or 4.1 in 3D at 3.1 l0), the lattice normalisers following
+it (VALIDATION.md "re = 3.1 l0 completed, and re = 4.0 l0": re + l0 holds the surface at re =
+4.0 l0);
 ``--relaxed-start P``: the 3D oscillating drop starts from its disordered start relaxed at
 rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0.
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
@@ -1360,7 +1361,7 @@ def main() -> None:
                     help="every drop's re / l0 (the cases' 2.1)")
     ap.add_argument("--pair-support", type=float, default=None, metavar="H",
                     help="C3's pair support in l0 (the neighbourhood's unless given: "
-                    "params.STRESS_NEIGHBOURHOODS, 3 at 2.1 l0, 4.1 at 3.1 l0)")
+                    "params.STRESS_NEIGHBOURHOODS: 3, or 4.1 in 3D at 3.1 l0)")
     ap.add_argument("--sound-factor", type=float, default=None,
                     help="every drop's sound speed times this (scenes/drop.drop_sound_speed)")
     ap.add_argument("--relaxed-start", type=float, default=0.0, metavar="P",

@@ -33,7 +33,8 @@ VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 # - "c4_factor": C4's F, the free surface's own normal stress F rho l0 a.g/|g|, per dimension;
 #   "lattice": the flat lattice face's balance n0/(2 d G l0) at that re
 #   (lattice.face_balance_factor: 1.160 / 1.187 in 2D / 3D at 3.1 l0); 1 at 2.1 l0, where the
-#   balance is 1.016 / 1.011, and in 3D at 3.1 l0, where the balance read the mode 4-5 % slow;
+#   balance is 1.016 / 1.011, and in 3D at 3.1 l0 (with the pairs to 4.1 l0 the balance read
+#   the mode 4.7 % slow at R/l0 = 10 with delta 0.80, and the larger delta lowers it more);
 # - "tolman": C5's curvature correction sigma (1 - delta H), delta in l0 per dimension; the
 #   surface of tension sits inside the liquid's surface (VALIDATION.md, "The curvature
 #   correction"); 0 compiles it out. 0.80 in 3D at 2.1 l0: the value at which the resting
@@ -44,8 +45,8 @@ VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 # 2.1 l0 is the seed's neighbourhood, the crowns'; at 3.1 l0 the 3D drops' Laplace and mode-2
 # frequency errors fall with resolution and the decay is 1.0-1.16 times Lamb's rate at R/l0 =
 # 10-16 (VALIDATION.md, "re = 3.1 l0 with C3's pairs to 4.1 l0"; 1.17-1.32 with H = 3 l0),
-# 1.5-1.9 times it at 2.1 l0 (a 3D particle has 122 lattice neighbours within re against 32). The constants are measured, not derived: another re is
-# refused.
+# 1.5-1.9 times it at 2.1 l0 (a 3D particle has 122 lattice neighbours within re against 32).
+# The constants are measured, not derived: another re is refused.
 # C5's s_i follows its step's value through a first-order lag of this many capillary times
 # sqrt(rho / (sigma |H|^3)) (about 1.6 periods of mode 2 of a drop of radius 1/|H|; method.md
 # §4c): a tension that followed the mode's own bending damped a 3D drop's oscillation

@@ -173,7 +173,8 @@ class StressTension:
         self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
         self.floor = None        # the analytic plane floor, where the model has one
         factor, delta = stress_constants(self.dim, model.stress_re_ratio)
-        self.pair_support = params.stress_pair_support(self.dim, model.stress_re_ratio)   # H / l0 (C3)
+        # C3's pair support H / l0, the neighbourhood's (compiled in)
+        self.pair_support = params.stress_pair_support(self.dim, model.stress_re_ratio)
         self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
         # C5: sigma (1 - delta H), delta in l0; s_i lagged in capillary time (_followed)
         self.delta = delta if self.tolman_delta is None else float(self.tolman_delta)
