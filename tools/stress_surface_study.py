@@ -92,8 +92,7 @@ the member's constants there (params.STRESS_NEIGHBOURHOODS: since 2026-12-07 at 
 the lattice and delta 0.9 in 2D, so the 3.1 l0 rows before, with F = 1, take ``--c4-factor 1``
 and in 2D ``--tolman 0``; since 2026-12-07's third session in 3D H = 4.1, F = 1 and delta
 1.25, so the 3D rows at 3.1 l0 before take ``--pair-support 3 --c4-factor lattice --tolman
-0.8`` and the 2D rows ``--pair-support 3``), elsewhere the seed neighbourhood's
-(admit_neighbourhood);
+0.8``; 2D keeps H = 3), elsewhere the seed neighbourhood's (admit_neighbourhood);
 ``--c4-factor F``: with ``--base member``, C4's pressure F rho l0 max(0, a_i . g_i/|g_i|) in
 place of the neighbourhood's F; ``lattice``: F = n0/(2 d G l0) at the run's re, the flat
 lattice face's balance (lattice.face_balance_factor: 1.011 in 3D at 2.1 l0, 1.187 at 3.1
