@@ -245,10 +245,8 @@ def admit_neighbourhood(re_over_l0: float) -> None:
     try:
         params.stress_neighbourhood(re_over_l0)
     except params.ParameterError:
-        seed = params.STRESS_NEIGHBOURHOODS[2.1]
-        params.STRESS_NEIGHBOURHOODS[re_over_l0] = {"pair_support": dict(seed["pair_support"]),
-                                                    "c4_factor": {2: 1.0, 3: 1.0},
-                                                    "tolman": dict(seed["tolman"])}
+        seed = params.STRESS_NEIGHBOURHOODS[params.SEED_NEIGHBOURHOOD]   # F = 1 there
+        params.STRESS_NEIGHBOURHOODS[re_over_l0] = {k: dict(v) for k, v in seed.items()}
 
 
 def tolman_delta_member(base, delta: float):

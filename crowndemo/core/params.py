@@ -60,23 +60,31 @@ STRESS_NEIGHBOURHOODS = {2.1: {"pair_support": {2: 3.0, 3: 3.0}, "c4_factor": {2
 SEED_NEIGHBOURHOOD = 2.1
 
 
-def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
-    """The key of STRESS_NEIGHBOURHOODS that ``re_ratio`` is (within 1e-9), or a
-    ParameterError naming re_ratio and the calibrated values."""
+def _neighbourhood_key(re_ratio: float) -> Optional[float]:
+    """The key of STRESS_NEIGHBOURHOODS that ``re_ratio`` is (within 1e-9), or None."""
     for key in STRESS_NEIGHBOURHOODS:
         if _finite(re_ratio) and abs(re_ratio - key) < 1e-9:
             return key
-    raise ParameterError("re_ratio", re_ratio, " or ".join(f"{k:g}" for k in STRESS_NEIGHBOURHOODS)
-                         + " with surface_tension: stress", source)
+    return None
+
+
+def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
+    """The key of STRESS_NEIGHBOURHOODS that ``re_ratio`` is (within 1e-9), or a
+    ParameterError naming re_ratio and the calibrated values."""
+    key = _neighbourhood_key(re_ratio)
+    if key is None:
+        raise ParameterError("re_ratio", re_ratio,
+                             " or ".join(f"{k:g}" for k in STRESS_NEIGHBOURHOODS)
+                             + " with surface_tension: stress", source)
+    return key
 
 
 def stress_pair_support(dim: int, re_ratio: float) -> float:
     """C3's pair support H/l0 in ``dim`` at ``re_ratio``: its neighbourhood's, or the seed
     neighbourhood's where it has none (the other members, which compile as at 2.1 l0)."""
-    for key, own in STRESS_NEIGHBOURHOODS.items():
-        if _finite(re_ratio) and abs(re_ratio - key) < 1e-9:
-            return float(own["pair_support"][dim])
-    return float(STRESS_NEIGHBOURHOODS[SEED_NEIGHBOURHOOD]["pair_support"][dim])
+    key = _neighbourhood_key(re_ratio)
+    own = STRESS_NEIGHBOURHOODS[SEED_NEIGHBOURHOOD if key is None else key]
+    return float(own["pair_support"][dim])
 
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given

@@ -70,7 +70,8 @@ def plan(case: Case, quick: bool, variants: bool, everywhere: Iterable[str] = ()
     resolution of the plan instead (validate --at-every-resolution)."""
     scales = case.quick if quick else case.scales
     out = [(s, "base") for s in scales]
-    wide = [v for v in case.variants if v in set(everywhere)]
+    wanted = set(everywhere)
+    wide = [v for v in case.variants if v in wanted]
     if variants:
         mid = scales[len(scales) // 2] if not quick else scales[-1]
         out += [(mid, v) for v in (case.quick_variants if quick else case.variants)
