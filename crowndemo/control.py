@@ -57,7 +57,7 @@ class Session:
         else:
             self.events.append(f"reused the compiled simulator ({n:,} of "
                                f"{sim.state.capacity:,} particles)")
-        sim.configure(scene.physics, scene.numerics, scene.domain)
+        sim.configure(scene.physics, scene.numerics, scene.domain, scene.floor)
         sim.load(scene.pos, scene.vel, scene.kind)
         return sim
 

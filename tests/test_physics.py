@@ -190,6 +190,41 @@ def test_collision_with_a_wall_particle_reflects_the_normal_speed():
     assert s["vel"][1] == pytest.approx([0.0, 0.0], abs=0.0)
 
 
+def _floor_patch(dim, l0):
+    """The wall layer of a particle floor around the origin: wall particles at z = -l0/2 (y in
+    2D) and x (, y) = +-l0/2, +-3 l0/2, as a scene's floor lattice (scenes/base.py)."""
+    from itertools import product
+    from crowndemo.core import WALL
+    offsets = [(k + 0.5) * l0 for k in (-2, -1, 0, 1)]
+    pos = [list(p) + [-0.5 * l0] for p in product(offsets, repeat=dim - 1)]
+    return pos, [WALL] * len(pos)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("where", ["between", "above"])
+def test_collision_with_the_particle_floor_s_wall_layer(dim, where):
+    # A fluid particle falling at v into a particle floor, 0.4 l0 above its wall-layer plane:
+    # between four (two in 2D) wall particles it is 0.81 (0.64) l0 from each, beyond the
+    # collision distance 0.5 l0, and passes the layer with the pairs alone; the floor's plane
+    # (a scene with a floor, Scene.floor) stops it as a wall particle right below does: the
+    # approach speed v becomes e v, once (not again by the plane where a wall pair took it).
+    l0, v, e = 1.0e-3, 1.0, 0.2
+    walls, kinds = _floor_patch(dim, l0)
+    x = [0.0] * (dim - 1) if where == "between" else [0.5 * l0] * (dim - 1)
+    fall = [0.0] * (dim - 1) + [-v]
+    for floor in (False, True):
+        sim = _pair_sim(dim, [x + [-0.1 * l0]] + walls, [fall] + [[0.0] * dim] * len(walls),
+                        [FLUID] + kinds, collision=Numerics().collision, e=e)
+        sim.configure(sim.physics, sim.numerics, floor=floor)
+        sim.step()
+        u = sim.snapshot()["vel"][0]
+        assert np.abs(u[:-1]).max() == 0.0
+        if where == "between" and not floor:
+            assert u[-1] == pytest.approx(-v, abs=1e-6)         # into the dummy layers
+        else:
+            assert u[-1] == pytest.approx(e * v, abs=1e-6)
+
+
 @pytest.mark.parametrize("collision", [0.0, Numerics().collision, 0.85])
 def test_free_surface_pair_cannot_collapse_with_collisions(collision):
     # Two particles with P = 0 (free surface, M3) closing at 2v: nothing else repels them.

@@ -84,6 +84,7 @@ def test_crown_scene_leaves_the_floor_particles_out():
     assert particles.counts()["wall"] > 0 and plane.counts()["wall"] == 0
     assert plane.counts()["dummy"] == 0 and plane.counts()["fluid"] == particles.counts()["fluid"]
     assert any("plane floor" in s for s in plane.info["left_out"])
+    assert particles.floor and plane.floor          # the collision model's floor plane
 
 
 @pytest.mark.parametrize("dim", [2, 3])
@@ -98,7 +99,7 @@ def test_fluid_past_the_wall_layers_plane_is_parked(dim, numerics):
     limits); the liquid resting on the floor stays."""
     l0 = 1e-3
     scene = hydrostatic_tank(dim=dim, l0=l0, width=0.006, depth=0.004, numerics=numerics)
-    assert scene.domain[0][-1] == pytest.approx(-0.5 * l0)
+    assert scene.domain[0][-1] == pytest.approx(-0.5 * l0) and scene.floor
     assert all(x < -3.0 * l0 for x in scene.domain[0][:-1])        # the side walls' margin
     pos = scene.pos.copy()
     fluid = np.flatnonzero(scene.kind == FLUID)

@@ -19,6 +19,6 @@ def simulator_for(scene: "Scene", capacity: Optional[int] = None,
                   max_cells: Optional[int] = None) -> Simulator:
     """A simulator sized for a scene, configured with its parameters and loaded with it."""
     sim = Simulator(scene.physics, scene.numerics, capacity or capacity_for(scene), max_cells)
-    sim.configure(scene.physics, scene.numerics, scene.domain)
+    sim.configure(scene.physics, scene.numerics, scene.domain, scene.floor)
     sim.load(scene.pos, scene.vel, scene.kind)
     return sim

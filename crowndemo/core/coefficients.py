@@ -23,12 +23,15 @@ class Coefficients:
         self.beta = s()               # free-surface threshold (M3)
         self.col_r2 = s()             # (collision distance)^2 of the collision model
         self.col_e = s()              # its restitution coefficient
+        self.floor_z = s()            # the particle floor's wall-layer plane, -l0/2 (terms.py)
         self.gravity = ti.Vector.field(dim, float, shape=())
         self.domain_lo = ti.Vector.field(dim, float, shape=())
         self.domain_hi = ti.Vector.field(dim, float, shape=())
 
     def set(self, physics: Physics, numerics: Numerics, lattice: LatticeConstants,
-            domain_lo: Sequence[float], domain_hi: Sequence[float]) -> None:
+            domain_lo: Sequence[float], domain_hi: Sequence[float], floor: bool = False) -> None:
+        """``floor``: the scene stands on a floor at z = 0 (scenes/base.py Scene.floor); else
+        the collision model's floor plane lies out of reach."""
         self.l0[None] = physics.l0
         self.re[None] = lattice.re
         self.re2[None] = lattice.re ** 2
@@ -46,6 +49,7 @@ class Coefficients:
         self.beta[None] = numerics.free_surface_beta(physics.dim)
         self.col_r2[None] = (numerics.collision * physics.l0) ** 2
         self.col_e[None] = numerics.restitution
+        self.floor_z[None] = -0.5 * physics.l0 if floor else -1e30
         g = [0.0] * self.dim
         g[-1] = -physics.gravity
         self.gravity[None] = g

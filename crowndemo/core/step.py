@@ -186,6 +186,7 @@ class Simulator:
         self._lists_ready = False
         self.health = Health(self.state, self.coef)
         self.domain = (tuple([-math.inf] * dim), tuple([math.inf] * dim))
+        self.on_floor = False       # a floor at z = 0 (configure's ``floor``)
         self.stats = RunStats()
         self.n_fluid = 0
         self.stage_seconds: Optional[Dict[str, float]] = None   # see time_stages
@@ -194,8 +195,10 @@ class Simulator:
 
     # ---- set-up --------------------------------------------------------------------------
     def configure(self, physics: Physics, numerics: Numerics,
-                  domain: Optional[tuple] = None) -> None:
-        """New run-time values; the compiled model must stay the same."""
+                  domain: Optional[tuple] = None, floor: Optional[bool] = None) -> None:
+        """New run-time values; the compiled model must stay the same. ``domain`` and
+        ``floor`` (a floor at z = 0, scenes/base.py Scene.floor) stay as set before unless
+        given."""
         physics.validate()
         numerics.validate()
         model = Model.of(physics, numerics)
@@ -208,10 +211,12 @@ class Simulator:
                                                 physics.rho, physics.sigma)
         if domain is not None:
             self.domain = (tuple(domain[0]), tuple(domain[1]))
+        if floor is not None:
+            self.on_floor = bool(floor)
         big = 1e30
         lo = [max(v, -big) for v in self.domain[0]]
         hi = [min(v, big) for v in self.domain[1]]
-        self.coef.set(physics, numerics, self.lattice, lo, hi)
+        self.coef.set(physics, numerics, self.lattice, lo, hi, self.on_floor)
         if self.floor is not None:
             self.floor.set(physics.dim, physics.l0, self.lattice.re, wall_layers(physics.re_ratio),
                            reach=self.lattice.re * self.model.wide_walk)

@@ -24,6 +24,9 @@ class Scene:
     domain: Box                 # particles outside are parked and counted
     t_end: float
     info: dict = field(default_factory=dict)   # geometry, walls present, what is left out
+    # a floor at z = 0 (y in 2D) whose wall-layer plane, z = -l0/2, the domain ends at
+    # (floor_cut): the collision model's plane there (core/terms.py)
+    floor: bool = False
 
     @property
     def dim(self) -> int:
@@ -88,7 +91,7 @@ def container_walls(inner_lo: Sequence[float], inner_hi: Sequence[float], l0: fl
 
 def assemble(name: str, physics: Physics, numerics: Numerics, fluid: np.ndarray,
              fluid_vel: Optional[np.ndarray], walls: Optional[Tuple[np.ndarray, np.ndarray]],
-             domain: Box, t_end: float, info: dict) -> Scene:
+             domain: Box, t_end: float, info: dict, floor: bool = False) -> Scene:
     dim = physics.dim
     parts_pos = [fluid]
     parts_vel = [fluid_vel if fluid_vel is not None else np.zeros_like(fluid)]
@@ -99,4 +102,4 @@ def assemble(name: str, physics: Physics, numerics: Numerics, fluid: np.ndarray,
         parts_kind.append(walls[1])
     pos = np.concatenate(parts_pos).reshape(-1, dim)
     return Scene(name, physics, numerics, pos, np.concatenate(parts_vel).reshape(-1, dim),
-                 np.concatenate(parts_kind), domain, t_end, info)
+                 np.concatenate(parts_kind), domain, t_end, info, floor)

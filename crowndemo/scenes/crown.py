@@ -131,4 +131,5 @@ def crown(dim: int = 3, l0: float = 5.0e-4, film: float = 1.0e-3, drop: float = 
         left_out.append(f"the mirror images across {across}: one {symmetry} of the scene is "
                         "simulated (counts are of that part)")
     numerics = with_values(numerics or Numerics(), mirror_planes=planes)
-    return assemble("crown", physics, numerics, fluid, vel, walls, domain, t_end, info)
+    return assemble("crown", physics, numerics, fluid, vel, walls, domain, t_end, info,
+                    floor=True)

@@ -42,7 +42,8 @@ def hydrostatic_tank(dim: int = 2, l0: float = 1.0e-3, width: float = 0.04, dept
                         tuple([width + margin] * (dim - 1) + [3.0 * depth])), l0)
     info = {"scene": "hydrostatic tank", "width_m": width, "depth_m": depth,
             "walls": faces, "wall_top_m": inner_hi[-1]}
-    return assemble("tank", ph, numerics or Numerics(), fluid, None, walls, domain, t_end, info)
+    return assemble("tank", ph, numerics or Numerics(), fluid, None, walls, domain, t_end, info,
+                    floor=True)
 
 
 def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float = 4.0,
@@ -65,7 +66,7 @@ def dam_break(dim: int = 2, a: float = 0.05, l0: float = 2.0e-3, length: float =
     info = {"scene": "dam break", "a_m": a, "length_a": length, "channel_a": channel,
             "walls": faces, "wall_top_m": inner_hi[-1]}
     return assemble("dam-break", ph, numerics or Numerics(), fluid, None, walls, domain, t_end,
-                    info)
+                    info, floor=True)
 
 
 def square_patch(dim: int = 2, side: float = 2.0e-3, l0: float = 1.0e-4,
@@ -179,7 +180,8 @@ def sliding_layer(dim: int = 2, delta: float = 1.0e-3, l0: float = 1.0e-4,
     info = {"scene": "sliding layer", "delta_m": delta, "speed_m_s": amplitude,
             "depth_m": depth, "length_m": length,
             "deficit_m2_s": amplitude * delta / math.sqrt(math.pi), "walls": faces}
-    return assemble("sliding-layer", ph, numerics, fluid, vel, walls, domain, t_end, info)
+    return assemble("sliding-layer", ph, numerics, fluid, vel, walls, domain, t_end, info,
+                    floor=True)
 
 
 def momentum_deficit(pos: np.ndarray, vel: np.ndarray, kind: np.ndarray, speed: float,
