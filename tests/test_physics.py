@@ -220,7 +220,7 @@ def test_collision_with_the_particle_floor_s_wall_layer(dim, where):
         u = sim.snapshot()["vel"][0]
         assert np.abs(u[:-1]).max() == 0.0
         if where == "between" and not floor:
-            assert u[-1] == pytest.approx(-v, abs=1e-6)         # into the dummy layers
+            assert u[-1] == pytest.approx(-v, abs=1e-6)         # on through the layer
         else:
             assert u[-1] == pytest.approx(e * v, abs=1e-6)
 

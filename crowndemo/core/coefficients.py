@@ -23,7 +23,8 @@ class Coefficients:
         self.beta = s()               # free-surface threshold (M3)
         self.col_r2 = s()             # (collision distance)^2 of the collision model
         self.col_e = s()              # its restitution coefficient
-        self.floor_z = s()            # the particle floor's wall-layer plane, -l0/2 (terms.py)
+        self.floor_z = s()            # the floor's wall-layer plane, -l0/2: the collision
+        #                               model's on the particle floor (terms.py)
         self.gravity = ti.Vector.field(dim, float, shape=())
         self.domain_lo = ti.Vector.field(dim, float, shape=())
         self.domain_hi = ti.Vector.field(dim, float, shape=())
