@@ -151,10 +151,9 @@ def main() -> None:
     a = ap.parse_args()
     from crowndemo import backend
     backend.init("cpu", threads=a.threads)
-    if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
-        import crowndemo.core.params as params_module
-        for own in params_module.STRESS_NEIGHBOURHOODS.values():
-            own["pair_support"] = {2: a.pair_support, 3: a.pair_support}
+    if a.pair_support is not None:
+        from stress_surface_study import set_pair_support
+        set_pair_support(a.pair_support)
     from crowndemo.core import Numerics
     from crowndemo.core.state import FLUID
     from crowndemo.scenes.drop import drop_sound_speed, oscillating_drop

@@ -249,6 +249,14 @@ def admit_neighbourhood(re_over_l0: float) -> None:
         params.STRESS_NEIGHBOURHOODS[re_over_l0] = {k: dict(v) for k, v in seed.items()}
 
 
+def set_pair_support(h_l0: float) -> None:
+    """``--pair-support H``: C3's pair support H l0 in every neighbourhood and dimension, read
+    at call time (by Model.of, the lattice normalisers and C3's kernel)."""
+    import crowndemo.core.params as params
+    for own in params.STRESS_NEIGHBOURHOODS.values():
+        own["pair_support"] = {2: h_l0, 3: h_l0}
+
+
 def tolman_delta_member(base, delta: float):
     """``base`` with C5's delta ``delta`` (l0) in place of its neighbourhood's (``--tolman``;
     StressTension.tolman_delta, read at __init__; 0 compiles C5 out)."""
@@ -1393,10 +1401,8 @@ def main() -> None:
     import crowndemo.core.surface_tension as family
     import crowndemo.core.surface_tension.stress as stress
     from crowndemo.core import Numerics
-    if a.pair_support is not None:    # read at call time: by Model.of, the normalisers, C3
-        import crowndemo.core.params as params_module
-        for own in params_module.STRESS_NEIGHBOURHOODS.values():
-            own["pair_support"] = {2: a.pair_support, 3: a.pair_support}
+    if a.pair_support is not None:
+        set_pair_support(a.pair_support)
     if a.core is not None:
         stress.CORE = a.core          # read when the member's kernels compile
     dim = (int(a.args[0]) if a.what == "drop" else 3 if a.what == "energy"
