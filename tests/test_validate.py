@@ -111,8 +111,10 @@ def test_quick_plan_keeps_every_case_with_one_variant():
     # oscillating drops' seed viscosity (another model compiled for a variant;
     # tests/test_viscosity.py holds the member itself), and the stress drops' wider
     # neighbourhood (another model; tests/test_stress_neighbourhoods.py runs a 2D drop there)
+    # and their corrected gradient form (another model; tests/test_corrected_gradient.py holds
+    # its identities)
     assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=laplacian",
-                            "re=3.1"}
+                            "re=3.1", "gradient=corrected"}
     assert set(cases.QUICK_VARIANT) == set(table) - {"crown-base-3m-drop"}
 
 

@@ -301,7 +301,8 @@ def register(sub, common) -> None:
                        help="acoustic Courant number c dt / l0 (default: %(default)g, S6)")
         q.add_argument("--gradient", choices=GRADIENT_FORMS, default="pmin",
                        help="pressure-gradient form: seed (P_j - P_i), pmin (P_j - Pmin_i), "
-                            "sum (P_j + P_i) (default: pmin)")
+                            "sum (P_j + P_i), corrected (P_i L_i + P_j L_j, L the inverse of "
+                            "the particle's fabric; method.md M2c) (default: pmin)")
         q.add_argument("--json", action="store_true", help="print the summary as one JSON object")
         q.add_argument("--quiet", action="store_true", help="no progress lines on stderr")
         q.set_defaults(func=lambda a, argv: _scene(a))

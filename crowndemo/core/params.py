@@ -9,7 +9,8 @@ import math
 from dataclasses import dataclass, fields, replace
 from typing import Any, Optional, Tuple, TypeVar
 
-GRADIENT_FORMS = ("seed", "pmin", "sum")   # (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i (M2)
+# (S11) with P_j - P_i; P_j - Pmin_i; P_j + P_i; P_i L_i + P_j L_j, L the fabric's (M2, M2c)
+GRADIENT_FORMS = ("seed", "pmin", "sum", "corrected")
 WALL_MODELS = ("particles", "plane")       # the floor: wall + dummy particles, or tables
 COURANT_SPEEDS = ("absolute", "relative")  # the speed of the Courant limit (S5; terms.py)
 # the surface-tension family (core/surface_tension/): the seed's potential (S22-S24) or the
@@ -214,6 +215,10 @@ class Numerics:
              and 1 <= self.cells_per_re <= 3, "cells_per_re", "1, 2 or 3")
         need(isinstance(self.reorder_every, int) and self.reorder_every >= 0, "reorder_every",
              "an integer >= 0 (0: never)")
+        need(self.pressure_gradient != "corrected" or (self.wall_model == "particles"
+                                                       and self.mirror_planes == ()),
+             "pressure_gradient", "seed | pmin | sum, or corrected with wall_model: particles "
+             "and no mirror_planes (its fabric L_i sums particles only, method.md M2c)")
         need(isinstance(self.mirror_planes, tuple)
              and self.mirror_planes in ((), (0,), (1,), (0, 1)), "mirror_planes",
              "(), (0,), (1,) or (0, 1): the planes x = 0 (0) and y = 0 (1)")

@@ -1,9 +1,14 @@
 """Pressure (method.md §3 steps 3-5): number density at r*, the equation of state (S17, M3)
-and the pressure-gradient corrector (S18-S20) in one of three forms (M2):
+and the pressure-gradient corrector (S18-S20) in one of four forms (M2, M2c):
 
 - ``seed``: (P_j - P_i), the gradient model (S11) as printed in the seed;
 - ``pmin``: (P_j - Pmin_i), Pmin_i the least pressure among i and its neighbours (repulsive);
-- ``sum``:  (P_j + P_i), the momentum-conserving form of explicit MPS papers.
+- ``sum``:  (P_j + P_i), the momentum-conserving form of explicit MPS papers;
+- ``corrected``: (P_i L_i + P_j L_j), the sum form with each particle's pressure taken through
+  its fabric's corrective matrix L_i = (tr M_i / d) M_i^-1, M_i = sum_j w r_ij r_ij^T / r^2
+  (M2c, method.md): still antisymmetric in i, j, and its pair forces do no work on any
+  uniform shear and exert no torque, so a pressure, a background one included, acts on
+  volume change alone (a particle set's fabric anisotropy is no shear stress).
 """
 
 from typing import Any, Optional
@@ -18,6 +23,10 @@ from .params import Model
 from .plane_floor import FLOOR_G, FLOOR_N, PlaneFloor
 from .state import DUMMY, FLUID, WALL
 
+# M2c: L_i = I where the fabric is degenerate, det M_i < FABRIC_DET_MIN (tr M_i / d)^d (a
+# particle with its neighbours on a line or a plane; a half-space's face reads 0.86 in 3D)
+FABRIC_DET_MIN = 0.05
+
 
 @ti.func
 def equation_of_state(n, n0, c2, rho, beta):
@@ -28,6 +37,14 @@ def equation_of_state(n, n0, c2, rho, beta):
     if n >= beta * n0:
         p = ti.max(c2 * rho * (n - n0) / n0, 0.0)
     return p
+
+
+@ti.func
+def surface_weight(n, n0, beta):
+    """omega = clamp((1 - n/n0) / (2 (1 - beta)), 0, 1) (C1, method.md §4c): 1 on the free
+    surface's outer layer, 1/2 at the free-surface threshold beta n0 (M3), 0 at n >= n0; the
+    stress member's colour gradient and M2c's corrective matrix fade in and out with it."""
+    return ti.min(ti.max((1.0 - n / n0) / (2.0 * (1.0 - beta)), 0.0), 1.0)
 
 
 def _gradient_sums(dim: int):
@@ -54,9 +71,18 @@ class Pressure:
         self._density_pair = make_density_task(coef)
         # not allocated when the model does without (a scene pays for what it uses)
         self.neighbours = NeighbourList(self.state) if model.neighbour_list else None
+        # M2c's corrective matrices, one per particle (I for walls), refreshed each step
+        self.corrected = model.pressure_gradient == "corrected"
+        if self.corrected:
+            if model.plane_floor or model.mirror_planes:
+                raise ValueError("the corrected pressure gradient sums its fabric over "
+                                 "particles: not with the plane floor or symmetry planes")
+            self.fabric = ti.Matrix.field(self.dim, self.dim, float, self.state.capacity)
 
     def nbytes(self) -> int:
-        return self.neighbours.nbytes() if self.neighbours is not None else 0
+        from .state import field_nbytes
+        own = field_nbytes(self.fabric) if self.corrected else 0
+        return own + (self.neighbours.nbytes() if self.neighbours is not None else 0)
 
     @property
     def _surface_in_corrector(self) -> bool:
@@ -84,6 +110,8 @@ class Pressure:
         """n (S9) and P (S17, M3), then the surface-tension member's boundary pressure; ``dt``
         the step's (what a member carries from step to step advances by it; 0 for output)."""
         self._density_and_pressure()
+        if self.corrected:
+            self._corrective_matrices()
         if self.surface is not None:
             self.surface.boundary_pressure(dt)
 
@@ -124,6 +152,33 @@ class Pressure:
                 self.state.pressure[i] = equation_of_state(n, n0, c2, rho, beta)
 
     @ti.func
+    def _fabric_pair(self, i, j, rij, r2, acc: ti.template()):
+        """M_i's term w r_ij r_ij^T / r^2 over the gradient's neighbours (dummies skipped)."""
+        if self.state.kind[j] != DUMMY:
+            acc += (weight(ti.sqrt(r2), self.coef.re[None]) / r2) * rij.outer_product(rij)
+
+    @ti.kernel
+    def _corrective_matrices(self):
+        """M2c: L_i = (tr M_i / d) M_i^-1 (I on a lattice), taken to I on the free surface as
+        C1's omega_i = clamp((1 - n_i/n0) / (2 (1 - beta)), 0, 1) rises: L_i = omega_i I +
+        (1 - omega_i) (tr M_i / d) M_i^-1, a polynomial in M_i, so M_i L_i stays symmetric and
+        the pairs exert no torque; the free surface's push (C4's balance) is the sum form's."""
+        n0, beta = self.coef.n0[None], self.coef.beta[None]
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
+            correction = ti.Matrix.identity(float, self.dim)
+            if self.state.kind[i] == FLUID:
+                m = ti.Matrix.zero(float, self.dim, self.dim)
+                self.grid.for_each_neighbour(i, self.state.pos[i], self.coef.re2[None],
+                                             self._fabric_pair, m)
+                iso = m.trace() / self.dim
+                omega = surface_weight(self.state.density[i], n0, beta)
+                if omega < 1.0 and iso > 0.0:
+                    if m.determinant() > FABRIC_DET_MIN * iso ** self.dim:
+                        correction = omega * correction + (1.0 - omega) * iso * m.inverse()
+            self.fabric[i] = correction
+
+    @ti.func
     def _gradient_pair(self, i, j, rij, r2, acc: ti.template()):
         """Accumulates, in one walk, sum P_j g_ij, sum g_ij (g_ij = r_ij w / r^2) and the least
         neighbour pressure, so every form of (M2) needs a single neighbour pass:
@@ -135,7 +190,10 @@ class Pressure:
     def _gradient_term(self, j, rij, r2, acc: ti.template()):
         p_j = self.state.pressure[j]
         g = gradient_pair(1.0, rij, r2, weight(ti.sqrt(r2), self.coef.re[None]))
-        acc.pg += p_j * g
+        if ti.static(self.corrected):
+            acc.pg += p_j * (self.fabric[j] @ g)         # M2c: P_j L_j g_ij
+        else:
+            acc.pg += p_j * g
         acc.g += g
         if ti.static(self.model.pressure_gradient == "pmin"):
             acc.pmin = ti.min(acc.pmin, p_j)
@@ -144,7 +202,8 @@ class Pressure:
     def correct(self, dt: float):
         """a' = -(1/rho) <grad P> (S18), plus the surface stress's divergence (C3) with that
         member; u += dt a' (S19); r += dt^2 a' (S20).
-        P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum).
+        P_ref, the pressure each i subtracts: P_i (seed), Pmin_i (pmin) or -P_i (sum); the
+        corrected form adds P_i L_i sum_j g_ij to sum_j P_j L_j g_ij (M2c).
         The neighbours come from the list of ``density_and_pressure`` (same positions) where
         it holds them all, else from the cell walk."""
         for at in range(self.state.n[None]):
@@ -187,6 +246,9 @@ class Pressure:
                 elif ti.static(self.model.pressure_gradient == "sum"):
                     p_ref = -p_i
                 grad = self.dim / self.coef.n0[None] * (acc.pg - p_ref * acc.g)
+                if ti.static(self.corrected):
+                    grad = self.dim / self.coef.n0[None] * (acc.pg + p_i * (self.fabric[i]
+                                                                            @ acc.g))
                 a = -grad / self.coef.rho[None]
                 if ti.static(self._surface_in_corrector):
                     a += self.surface.acceleration(i)      # the surface stress (C3) at r*
@@ -198,4 +260,4 @@ class Pressure:
                 self.state.pos[i] += dt * dt * self.state.scratch_vec[i]
 
 
-__all__ = ["Pressure", "equation_of_state"]
+__all__ = ["Pressure", "equation_of_state", "surface_weight"]

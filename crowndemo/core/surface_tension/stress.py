@@ -90,6 +90,7 @@ from ..grid import CellGrid
 from .. import params
 from ..lattice import stress_constants
 from ..params import Model
+from ..pressure import surface_weight
 from ..state import FLUID, GONE, field_nbytes
 
 CORE = 0.75     # f_d changes sign at CORE l0 (C3): closer surface pairs repel (module docstring)
@@ -229,9 +230,7 @@ class StressTension:
         """omega_i = clamp((1 - n_i/n0) / (2 (1 - beta)), 0, 1) (C1): 1 on the free surface's
         outer layer (n ~ 0.5-0.75 n0), 1/2 at the free-surface threshold beta n0 (M3), 0 at
         n >= n0, so the colour gradient's noise inside a disordered liquid carries no tension."""
-        n0 = self.coef.n0[None]
-        x = (1.0 - self.state.density[i] / n0) / (2.0 * (1.0 - self.coef.beta[None]))
-        return ti.min(ti.max(x, 0.0), 1.0)
+        return surface_weight(self.state.density[i], self.coef.n0[None], self.coef.beta[None])
 
     @ti.kernel
     def _sync_images(self):
