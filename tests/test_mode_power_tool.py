@@ -109,6 +109,32 @@ def test_viscous_terms_are_the_predictors(dim, viscosity):
     np.testing.assert_allclose(numpy_sum, kernel, rtol=rtol, atol=rtol * np.abs(kernel).max())
 
 
+@pytest.mark.parametrize("dim", [2, 3])
+def test_corrected_form_is_the_correctors(dim):
+    """With the corrected gradient form (M2c) the tool's pressure force is the corrector's a'
+    on a disordered ball (its surface's L_i faded to I by omega, the interior's the fabric's
+    correction), to float rounding."""
+    from crowndemo.core.params import with_values
+    from crowndemo.core import Simulator
+    x = disordered_ball(dim, 4.0, 0.15)
+    sim = probe_simulator(dim, len(x), "central")
+    numerics = with_values(sim.numerics, pressure_gradient="corrected")
+    sim = Simulator(sim.physics, numerics, len(x))
+    sim.configure(sim.physics, numerics, (tuple([-1.0] * dim), tuple([1.0] * dim)))
+    sim.load(x, np.zeros_like(x), np.full(len(x), FLUID, dtype=np.int32))
+    sim.grid.build(RE_RATIO * L0)            # no re-sort: field index i = i-th particle
+    sim.pressure.density_and_pressure()
+    p = np.random.default_rng(4).uniform(50.0, 150.0, len(x))
+    full = np.zeros(sim.state.capacity, dtype=sim.state.pressure.to_numpy().dtype)
+    full[: len(x)] = p
+    sim.state.pressure.from_numpy(full)
+    sim.pressure.correct(1.0e-6)
+    kernel = sim.state.scratch_vec.to_numpy()[: len(x)].astype(float)
+    numpy_sum = tool.forces(sim, x, np.zeros_like(x), p, "central")["pressure"]
+    rtol = 1e-10 if backend.is_f64() else 2e-4
+    np.testing.assert_allclose(numpy_sum, kernel, rtol=rtol, atol=rtol * np.abs(kernel).max())
+
+
 def test_face_balance_factor_of_the_study_tools():
     """lattice.face_balance_factor, the study tools' ``--c4-factor lattice``: C4's factor
     n0 / (2 d G l0) from the lattice sums, the value above at re = 2.1 l0, and larger in a wider

@@ -80,10 +80,12 @@ def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float
 
 def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
            viscosity: str) -> Dict[str, np.ndarray]:
-    """The pressure gradient (sum form, M2), its zeroth-order part (``zeroth``) and the viscous
+    """The pressure gradient (sum form, M2, or the corrected form, M2c, where the simulator
+    runs it: every fluid particle's omega from these pairs, a drop's), its zeroth-order part (``zeroth``) and the viscous
     term (the member ``viscosity``: V1 or S12) [m/s^2], numpy over the pairs within re
     (validate/clusters.close_pairs)."""
     from crowndemo.core.lattice import weight
+    from crowndemo.core.pressure import FABRIC_DET_MIN
     from crowndemo.core.viscosity import member
     from crowndemo.validate.clusters import close_pairs
     lat, ph = sim.lattice, sim.physics
@@ -94,6 +96,21 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
     n = len(x)
     # M2: a_i = -d / (n0 rho) sum_j (P_i + P_j) r_ij w / r^2, r_ij = x_j - x_i (antisymmetric)
     acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, ((p[i] + p[j]) * w / r2)[:, None] * rij, -1)
+    if sim.numerics.pressure_gradient == "corrected":
+        # M2c: (P_i L_i + P_j L_j) r_ij w / r^2, L_i = omega I + (1 - omega) (tr M_i/d) M_i^-1
+        g = (w / r2)[:, None] * rij
+        fabric = pair_sum(n, i, j, g[:, :, None] * rij[:, None, :], 1)
+        omega = np.clip((1.0 - pair_sum(n, i, j, w, 1) / n0)
+                        / (2.0 * (1.0 - sim.numerics.free_surface_beta(dim))), 0.0, 1.0)
+        iso = np.trace(fabric, axis1=1, axis2=2) / dim
+        L = np.repeat(np.eye(dim)[None], n, axis=0)
+        full = (omega < 1.0) & (iso > 0.0)
+        full[full] &= np.linalg.det(fabric[full]) > FABRIC_DET_MIN * iso[full] ** dim
+        L[full] = (omega[full, None, None] * np.eye(dim) + (1.0 - omega[full, None, None])
+                   * iso[full, None, None] * np.linalg.inv(fabric[full]))
+        f = (p[i, None] * np.einsum("kab,kb->ka", L[i], g)
+             + p[j, None] * np.einsum("kab,kb->ka", L[j], g))
+        acc_p = -dim / (n0 * rho) * pair_sum(n, i, j, f, -1)
     # its split: (P_j - P_i) r_ij w / r^2 (the gradient, S11) + 2 P_i r_ij w / r^2 (this part)
     acc_zero = -dim / (n0 * rho) * 2.0 * p[:, None] * pair_sum(n, i, j,
                                                                 (w / r2)[:, None] * rij, -1)
