@@ -80,10 +80,10 @@ def pair_sum(n: int, i: np.ndarray, j: np.ndarray, f_ij: np.ndarray, sign: float
 
 def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
            viscosity: str) -> Dict[str, np.ndarray]:
-    """The pressure gradient (sum form, M2, or the corrected form, M2c, where the simulator
-    runs it: every fluid particle's omega from these pairs, a drop's), its zeroth-order part (``zeroth``) and the viscous
-    term (the member ``viscosity``: V1 or S12) [m/s^2], numpy over the pairs within re
-    (validate/clusters.close_pairs)."""
+    """The pressure gradient (the sum form, M2, or the corrected form, M2c, where the simulator
+    runs it: each particle's omega from these pairs, a drop's), its zeroth-order part
+    (``zeroth``, the sum form's) and the viscous term (the member ``viscosity``: V1 or S12)
+    [m/s^2], numpy over the pairs within re (validate/clusters.close_pairs)."""
     from crowndemo.core.lattice import weight
     from crowndemo.core.pressure import FABRIC_DET_MIN
     from crowndemo.core.viscosity import member
