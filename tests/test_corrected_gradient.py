@@ -106,9 +106,9 @@ def test_the_pressure_does_no_work_on_a_shear_or_a_rotation(dim):
 @pytest.mark.parametrize("dim", [2, 3])
 def test_momentum_and_a_linear_pressure(dim):
     """The pairs are antisymmetric: sum_i a'_i = 0 for any pressure. And on the lattice (no
-    disorder, spacing l0: L = I inside) a linear pressure P0 + b.x reads its gradient, a' = -b/rho, as the
-    sum form's does (test_step_terms.py) where i's neighbours' neighbourhoods are whole too
-    (2 re from the block's edge: a neighbour's L_j near the edge is not I)."""
+    disorder, spacing l0: L = I inside) a linear pressure P0 + b.x reads its gradient, a' =
+    -b/rho, as the sum form's does (test_step_terms.py), where i's neighbours' neighbourhoods
+    are whole too (2 re from the block's edge: a neighbour's L_j near the edge is not I)."""
     sim, pos = block(dim, "corrected")
     _, inner, _ = fabric_and_interior(dim, pos)
     rng = np.random.default_rng(11)

@@ -71,12 +71,10 @@ class Pressure:
         self._density_pair = make_density_task(coef)
         # not allocated when the model does without (a scene pays for what it uses)
         self.neighbours = NeighbourList(self.state) if model.neighbour_list else None
-        # M2c's corrective matrices, one per particle (I for walls), refreshed each step
+        # M2c's corrective matrices, one per particle (I for walls), refreshed each step; not
+        # with the plane floor or symmetry planes (Numerics.validate refuses those)
         self.corrected = model.pressure_gradient == "corrected"
         if self.corrected:
-            if model.plane_floor or model.mirror_planes:
-                raise ValueError("the corrected pressure gradient sums its fabric over "
-                                 "particles: not with the plane floor or symmetry planes")
             self.fabric = ti.Matrix.field(self.dim, self.dim, float, self.state.capacity)
 
     def nbytes(self) -> int:
@@ -245,10 +243,10 @@ class Pressure:
                     p_ref = acc.pmin
                 elif ti.static(self.model.pressure_gradient == "sum"):
                     p_ref = -p_i
-                grad = self.dim / self.coef.n0[None] * (acc.pg - p_ref * acc.g)
+                own = -p_ref * acc.g          # i's own pressure over sum_j g_ij
                 if ti.static(self.corrected):
-                    grad = self.dim / self.coef.n0[None] * (acc.pg + p_i * (self.fabric[i]
-                                                                            @ acc.g))
+                    own = p_i * (self.fabric[i] @ acc.g)      # M2c: P_i L_i sum_j g_ij
+                grad = self.dim / self.coef.n0[None] * (acc.pg + own)
                 a = -grad / self.coef.rho[None]
                 if ti.static(self._surface_in_corrector):
                     a += self.surface.acceleration(i)      # the surface stress (C3) at r*
