@@ -144,3 +144,40 @@ def test_face_balance_factor_of_the_study_tools():
     assert face_balance_factor(2, 2.1) == pytest.approx(1.016, abs=1e-3)
     assert face_balance_factor(3, 2.1) == pytest.approx(1.011, abs=1e-3)
     assert face_balance_factor(2, 3.1) == pytest.approx(18.9764 / (4 * 4.0898), rel=1e-4)
+
+
+def test_stiffness_fit_recovers_a_damped_oscillators_spring_and_damper():
+    """The stiffness split (VALIDATION.md "The mode's stiffness, force by force"): for a damped
+    oscillator q = exp(-gamma t) cos(omega t), M q_ddot = -K q - C q_dot with K = M (omega^2 +
+    gamma^2) and C = 2 M gamma; the spring's and the damper's generalised forces, each with a
+    steady part, are fitted back to (K, 0) and (0, C), and their sum to (K, C)."""
+    M, omega, gamma = 2.5e-7, 760.0, 45.0
+    t = np.linspace(0.0, 5 * 2 * np.pi / omega, 201)
+    q = np.exp(-gamma * t) * np.cos(omega * t)
+    q_dot = np.exp(-gamma * t) * (-gamma * np.cos(omega * t) - omega * np.sin(omega * t))
+    K, C = M * (omega ** 2 + gamma ** 2), 2.0 * M * gamma
+    spring, damper = -K * q + 3e-3, -C * q_dot - 1e-3
+    for force, want in ((spring, (K, 0.0)), (damper, (0.0, C)), (spring + damper, (K, C))):
+        got = tool.fit_stiffness(q, q_dot, force)
+        assert got[0] == pytest.approx(want[0], rel=1e-9, abs=1e-9 * K)
+        assert got[1] == pytest.approx(want[1], rel=1e-9, abs=1e-9 * C)
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_mode_coordinate_of_a_ball_stretched_along_the_mode(dim):
+    """mode_coordinate: a lattice ball mapped by x -> (I + q G_hat) x (G_hat symmetric
+    traceless, |G_hat| = 1) reads q to O(q^2) (second order: 1e-6 at q = 1e-3), and for the
+    velocity u = q_dot G_hat x it reads q_dot; a rotation reads nothing."""
+    from crowndemo.scenes.drop import ball
+    x0 = ball(dim, 1.0, 0.1)
+    x0 = x0 - x0.mean(axis=0)
+    G_hat = np.diag([1.0, -1.0]) if dim == 2 else np.diag([-0.5, -0.5, 1.0])
+    G_hat = G_hat / np.linalg.norm(G_hat)
+    q, q_dot = 1e-3, 7.0
+    d = x0 @ (np.eye(dim) + q * G_hat).T
+    got_q, got_rate = tool.mode_coordinate(d, q_dot * d @ G_hat.T, G_hat)
+    assert got_q == pytest.approx(q, abs=2 * q * q)
+    assert got_rate == pytest.approx(q_dot, rel=2 * q)
+    spin = np.zeros((dim, dim))
+    spin[0, 1], spin[1, 0] = 1.0, -1.0
+    assert abs(tool.mode_coordinate(x0, x0 @ spin.T, G_hat)[1]) < 1e-12

@@ -51,8 +51,13 @@ E_m (a loss at Lamb's rate gamma is -4 gamma T of it; the period that ends at th
 it in its last frame and is not read). Over the periods read (from the kick on; without
 one, from where the case's fit starts: the second period in 3D, the first in 2D): each
 force's mean work, layer by layer; the decay from the peaks of E_m, one a half period,
-gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T); and the deformation's fit (the case's,
-validate/oscillation.py). From each peak of E_m to the next: the kinetic energy's change
+gamma = -ln(E_peak(k + 1) / E_peak(k)) / (2 T); each force's share of the mode's stiffness
+and damping: its generalised force on the mode's shape xi = G_hat d (G_hat the start's flow's
+symmetric traceless part, |G_hat| = 1), Q_f = m sum_i a_i . xi_i, fitted as -K_f q - C_f q_dot
++ b_f against the mode's coordinate q (from the second moment, ``mode_coordinate``), so that
+M q_ddot = sum_f Q_f with M = m sum |xi|^2: K_f / (M omega_R^2) is the force's part of (omega /
+omega_R)^2 (VALIDATION.md "The mode's stiffness, force by force"); and the deformation's fit
+(the case's, validate/oscillation.py). From each peak of E_m to the next: the kinetic energy's change
 beside each force's work on every particle's motion (in the continuum the pressure's and the
 stress's would be nil, the drop round at both ends; VALIDATION.md "The surface's push and
 pull along its normal"). numpy over the pairs within re (a few thousand particles: seconds
@@ -121,6 +126,51 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
         f = du * w[:, None]
     acc_v = ph.nu * member(viscosity).factor(dim) / (lat.lambda0 * n0) * pair_sum(n, i, j, f, -1)
     return {"pressure": acc_p, "viscosity": acc_v, "zeroth": acc_zero}
+
+
+def mode_coordinate(d: np.ndarray, u: np.ndarray, G_hat: np.ndarray) -> tuple:
+    """Mode 2's coordinate q and its rate for positions d and velocities u about the centre:
+    x = (I + q G_hat) x_round (G_hat symmetric traceless, |G_hat| = 1) makes the second moment
+    S = sum d d^T = s0 I + 2 q s0 G_hat + O(q^2), s0 = tr S / dim; so q = S : G_hat / (2 s0),
+    and q_dot the same of dS/dt = sum (d u^T + u d^T)."""
+    S, s0 = d.T @ d, float((d * d).sum()) / d.shape[1]
+    dS = d.T @ u + u.T @ d
+    return float((S * G_hat).sum()) / (2.0 * s0), float((dS * G_hat).sum()) / (2.0 * s0)
+
+
+def fit_stiffness(q: np.ndarray, q_dot: np.ndarray, force: np.ndarray) -> tuple:
+    """(K, C): a force's generalised force on the mode fitted as -K q - C q_dot + b over the
+    frames (least squares; b takes a steady part, such as a drop's Laplace pull on a mode of
+    nonzero mean)."""
+    basis = np.stack([q, q_dot, np.ones_like(q)], axis=1)
+    coef = np.linalg.lstsq(basis, force, rcond=None)[0]
+    return -float(coef[0]), -float(coef[1])
+
+
+def stiffness(rows: list, keep: np.ndarray, names: tuple, layers: tuple,
+              omega_ref: float) -> None:
+    """Each force's share of the mode's stiffness and damping (``fit_stiffness`` over the frames
+    kept): M q_ddot = sum_f Q_f, so omega^2 + gamma^2 = sum K_f / M and the amplitude's decay
+    gamma = sum C_f / (2 M). Printed: K_f / (M omega_ref^2) (their sum is (omega /
+    omega_ref)^2 up to gamma^2) and C_f / (2 M) [1/s], for the whole drop and by layer."""
+    rows = [r for r, k in zip(rows, keep) if k]
+    q, q_dot = (np.array([r[k] for r in rows]) for k in ("q", "q_dot"))
+    M = float(np.mean([r["M"] for r in rows]))
+
+    def share(key) -> tuple:
+        K, C = fit_stiffness(q, q_dot, np.array([r[key] for r in rows]))
+        return K / (M * omega_ref ** 2), C / (2.0 * M)
+
+    print(f"the mode's stiffness and damping, force by force (fitted over {len(rows)} frames: "
+          f"K / (M omega_R^2), C / 2M in 1/s; by layer: " + ", ".join(layers) + "):")
+    for f in names + ("zeroth", "stress normal", "zeroth normal"):
+        k, c = share(("Q", f))
+        by = [share(("Q", f, layer)) for layer in layers] if f in names + ("zeroth",) else []
+        print(f"  {f}: {k:+.3f}, {c:+.1f}" + (" (" + " ".join(
+            f"{kk:+.3f}/{cc:+.1f}" for kk, cc in by) + ")" if by else ""))
+    total = [sum(share(("Q", f))[k] for f in names) for k in (0, 1)]
+    print(f"  sum: {total[0]:+.3f} (omega {math.sqrt(max(total[0], 0.0)) - 1:+.2%} against "
+          f"omega_R, up to gamma^2), decay {total[1]:.1f} 1/s")
 
 
 def linear_flow(sim) -> tuple:
@@ -215,6 +265,11 @@ def main() -> None:
                                                      a.tolman_steps, a.tolman_lag)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
+    # the mode's shape for the stiffness: xi = G_hat d, G_hat the start's flow's symmetric
+    # traceless part with |G_hat| = 1 (mode 2 of a drop is exactly a linear field)
+    G_hat = 0.5 * (G0 + G0.T)
+    G_hat -= np.trace(G_hat) / a.dim * np.eye(a.dim)
+    G_hat /= np.linalg.norm(G_hat)
     kick_frame = int(round(a.kick * a.frames)) if a.kick > 0 else -1
     layers = ("surface", "under 1.5 l0", "1.5-2.5 l0", "deeper")
     rows = []
@@ -252,6 +307,16 @@ def main() -> None:
                "E_rest": 0.5 * mass * float((rest * rest).sum()),
                "deformation": oscillation.deformation(x)}
         row["E_kin"] = 0.5 * mass * float((u * u).sum())
+        # the mode's coordinate q (x = (I + q G_hat) x_round: S = s0 I + 2 q s0 G_hat), its
+        # rate, its mass M = m sum |xi|^2 and each force's generalised force m sum a . xi
+        xi = d @ G_hat.T
+        row["q"], row["q_dot"] = mode_coordinate(d, u, G_hat)
+        row["M"] = mass * float((xi * xi).sum())
+        for name, a_i in acc.items():
+            gen = mass * (a_i * xi).sum(axis=1)
+            row[("Q", name)] = float(gen.sum())
+            for layer, m in zip(layers, masks):
+                row[("Q", name, layer)] = float(gen[m].sum())
         for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
             row[name] = float(power.sum())
@@ -324,6 +389,7 @@ def main() -> None:
           + " ".join(f"{g:.1f}" for g in gammas)
           + f" 1/s (mean {np.mean(gammas):.1f}; Lamb's {lamb:.1f})")
     fit = t >= first * period - 1e-12
+    stiffness(rows, fit, names, layers, scene.info["omega_rad_s"])
     omega, decay = oscillation.fit(t[fit], np.array([r["deformation"] for r in rows])[fit])
     ref = scene.info["omega_rad_s"]
     print(f"the deformation's fit from period {first} on (as the case's): {omega:.1f} rad/s "
