@@ -181,3 +181,31 @@ def test_mode_coordinate_of_a_ball_stretched_along_the_mode(dim):
     spin = np.zeros((dim, dim))
     spin[0, 1], spin[1, 0] = 1.0, -1.0
     assert abs(tool.mode_coordinate(x0, x0 @ spin.T, G_hat)[1]) < 1e-12
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_surface_pairs_normaliser_of_the_study_tools(dim):
+    """``--surface-pairs`` (tools/stress_surface_study.py, VALIDATION.md "The mode's
+    stiffness, force by force"): its unweighted cut sum is the member's, a = 1 / (K_d sum)
+    (lattice.stress_normaliser); the flat lattice's layers' omega (C1) are 1 on the face and,
+    one layer in, the number density's deficit over 2 (1 - beta): in 3D that layer lacks only
+    the neighbour two spacings out (w = 2.1/2 - 1), in 2D also none other within 2.1 l0; so
+    the weighted sum keeps the face's own pairs and a share omega_1 of its pairs with the
+    layer beneath, and the ratio (a's factor) exceeds 1."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    import stress_surface_study as study
+    from crowndemo.core import Numerics
+    from crowndemo.core.lattice import (n0_lambda0, stress_gradient_norm, stress_normaliser,
+                                        stress_pair_kernel, stress_pair_support)
+    beta = Numerics().free_surface_beta(dim)
+    plain, weighted = study.cut_sums(dim, 2.1, beta)
+    h = stress_pair_support(dim, 1.0, 2.1)
+    K_d = stress_gradient_norm(dim, 1.0, 2.1, stress_pair_kernel, h)
+    assert 1.0 / (K_d * plain) == pytest.approx(stress_normaliser(dim, 1.0, 2.1), rel=1e-12)
+    n0 = n0_lambda0(dim, 1.0, 2.1)[0]
+    omega = study._layer_omega(dim, 2.1, beta, 3)
+    assert omega[0] == 1.0
+    assert omega[1] == pytest.approx((2.1 / 2.0 - 1.0) / n0 / (2.0 * (1.0 - beta)), rel=1e-12)
+    assert omega[2] == 0.0
+    assert study.surface_pairs_ratio(dim, 2.1, beta) > 1.0

@@ -6,7 +6,7 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
                           [--pair-support H] [--tolman DELTA]
                           [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
-                          [--tolman-lag K]
+                          [--tolman-lag K] [--surface-pairs] [--tension-factor F]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -25,7 +25,8 @@ DELTA: C5's delta in place of the
 neighbourhood's (0 compiles C5 out); --tolman-form / --tolman-steps: C5's probes (s_i on
 i's whole pull, smoothed over the surface, or lagged N steps); --tolman-lag K: the member's
 lag of C5 in capillary times (0: none, the member to 2026-12-07); all as in
-tools/stress_surface_study.py. F frames a period
+tools/stress_surface_study.py; --surface-pairs, --tension-factor: its options of those names
+(C3's pairs within the surface layer; the member's tension times F). F frames a period
 (default 40); at each:
 
 - the mode's flow: the velocities of every fluid particle (a thrown-out one too) about their
@@ -214,6 +215,10 @@ def main() -> None:
                     help="--tolman-form lagged: the lag in steps")
     ap.add_argument("--tolman-lag", type=float, default=None, metavar="K",
                     help="C5's lag in capillary times (stress_surface_study --tolman-lag)")
+    ap.add_argument("--surface-pairs", action="store_true",
+                    help="C3's pairs weighted by omega_i omega_j (stress_surface_study's option)")
+    ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
+                    help="the member's tension (a) times F")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -263,6 +268,16 @@ def main() -> None:
         from stress_surface_study import tolman_form_member
         family.MODELS["stress"] = tolman_form_member(family.MODELS["stress"], a.tolman_form,
                                                      a.tolman_steps, a.tolman_lag)
+    if a.surface_pairs or a.tension_factor is not None:
+        import crowndemo.core.surface_tension as family
+        from stress_surface_study import surface_pairs_member, tension_factor_member
+        if a.surface_pairs:
+            family.MODELS["stress"] = surface_pairs_member(
+                family.MODELS["stress"], a.dim, scene.physics.re_ratio,
+                numerics.free_surface_beta(a.dim))
+        if a.tension_factor is not None:
+            family.MODELS["stress"] = tension_factor_member(family.MODELS["stress"],
+                                                            a.tension_factor)
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     # the mode's shape for the stiffness: xi = G_hat d, G_hat the start's flow's symmetric

@@ -16,6 +16,7 @@ layer does" and after, issue 23), reproducible:
                           [--continuity]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
+    .venv/bin/python tools/stress_surface_study.py depth DIM R/l0[,R/l0...]
     .venv/bin/python tools/stress_surface_study.py energy R/l0 [--base member] [--relaxed-start P]
                           [--amplitude A] [the drop options]
 
@@ -37,7 +38,9 @@ A_d/A and V_d/V (VALIDATION.md, "What sets the inside pressure") and the ratio o
 virial to the tension's (1 at rest); ``--profile`` adds P n/n0 over P_in in shells. ``case``: one
 row of a stress-* validation case (validate/tension_cases.py). ``stretch``: the tension a flat
 2D surface carries by the member's formulas when its outer layer's spacing is S l0, alone and
-with the tangential moment (``flat_tension``; numpy, no Taichi). ``energy``: where the 3D
+with the tangential moment (``flat_tension``; numpy, no Taichi). ``depth``: where the
+member's tension and its pull sit under a lattice ball's surface, with C3 as the member has it
+and with ``--surface-pairs`` (``pull_depth``; numpy). ``energy``: where the 3D
 oscillating drop's kinetic energy goes (the mode's flow, the rest; ``energy``'s docstring).
 
 Experiments, not member options (VALIDATION.md says what each did):
@@ -57,6 +60,10 @@ the particle has, theta = 1 - C |g| l0 (``--theta-slope`` C, fitted on lattice f
 w-weighted mean C4 pressure of its free-surface neighbours outward of it (a third pass);
 ``--continuity``: every fluid particle's pressure is the EOS of a number density carried by the
 continuity equation instead of S17's sum (continuity_pressure_member; a third pass);
+``--surface-pairs`` (``--base member``, re = 2.1 l0): C3's pair terms times omega_i omega_j,
+C1's surface weights, so the pull lands on the surface layer that carries the tension, a
+rescaled on the flat lattice with the same weights (surface_pairs_member; VALIDATION.md "The
+mode's stiffness, force by force"); ``--tension-factor F``: the member's a times F;
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -639,6 +646,142 @@ def membrane_member(base, dim: int, ref: float, kernel: str = "quartic"):
                 acc += ratio * phi * f * self._pair_weight(ti.sqrt(r2))
 
     return MembraneStress
+
+
+def _layer_omega(dim: int, re_over_l0: float, beta: float, layers: int) -> np.ndarray:
+    """C1's omega of the layers k = 0, 1, ... of a flat lattice half-space (l0 = 1)."""
+    from crowndemo.core.lattice import lattice_offsets, weight
+    offs = lattice_offsets(dim, 1.0, re_over_l0)
+    w = weight(np.linalg.norm(offs, axis=1), re_over_l0)
+    out = np.zeros(layers)
+    for k in range(layers):
+        n = w[-k + offs[:, -1] <= 1e-6].sum()
+        out[k] = min(max((1.0 - n / w.sum()) / (2.0 * (1.0 - beta)), 0.0), 1.0)
+    return out
+
+
+def surface_pairs_ratio(dim: int, re_over_l0: float, beta: float) -> float:
+    """a_pairs / a: the flat lattice face's normaliser (lattice.stress_normaliser's cut sum)
+    with each pair's term weighted by omega_i omega_j (``surface_pairs_member``)."""
+    plain, weighted = cut_sums(dim, re_over_l0, beta)
+    return plain / weighted
+
+
+def cut_sums(dim: int, re_over_l0: float, beta: float) -> tuple:
+    """lattice.stress_normaliser's cut sum over a flat lattice face (l0 = 1; a = 1 / (K_d
+    sum)), plain and with each pair's term times omega_i omega_j of the two layers."""
+    from crowndemo.core.lattice import (colour_gradient_column, lattice_offsets,
+                                        stress_pair_kernel, stress_pair_support)
+    h = stress_pair_support(dim, 1.0, re_over_l0)
+    offs = lattice_offsets(dim, 1.0, h)
+    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
+    g = colour_gradient_column(dim, 1.0, re_over_l0)
+    om = _layer_omega(dim, re_over_l0, beta, len(g) + int(math.ceil(h)) + 1)
+    plain = weighted = 0.0
+    for k in range(len(g)):
+        for off, ff in zip(offs, f):
+            kj = k - int(round(off[-1]))
+            if off[0] > 0 and kj >= 0:
+                term = off[0] ** 2 * ff * (g[k] + (g[kj] if kj < len(g) else 0.0))
+                plain += term
+                weighted += term * om[k] * om[kj]
+    return plain, weighted
+
+
+def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float):
+    """``base`` with ``--surface-pairs``: C3's pair terms times omega_i omega_j (C1's surface
+    weights), so the divergence is taken among the particles that carry the tension and the
+    pull lands on the surface layer rather than a spacing under it; a rescaled so that a flat
+    lattice face still carries sigma (``surface_pairs_ratio``). C5's sums as the member's."""
+    from crowndemo.core.surface_tension import stress as S
+    ratio = surface_pairs_ratio(dim, re_over_l0, beta)
+
+    @ti.data_oriented
+    class SurfacePairsStress(base):
+        @ti.func
+        def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
+            if self.state.kind[j] != S.GONE:
+                r = ti.sqrt(r2)
+                gi, gj = self.colour[i], self.colour[j]
+                w = ratio * self._surface_weight(i) * self._surface_weight(j)
+                acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r) * w
+                if ti.static(self.delta > 0.0):
+                    g_min = S.NORMAL_MIN / self.coef.l0[None]
+                    if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
+                        acc.h += S.normal_divergence_terms(
+                            gi.normalized(), gj.normalized(), rij,
+                            S.stress_kernel(r, self.coef.re[None]))
+
+    return SurfacePairsStress
+
+
+def tension_factor_member(base, factor: float):
+    """``base`` with its tension times ``factor`` (``--tension-factor``: a -> factor a, C3's
+    pull and so C4's pressure; C1 and C5's curvature unchanged)."""
+    @ti.data_oriented
+    class ScaledStress(base):
+        @ti.func
+        def _pair_weight(self, r):
+            return factor * base._pair_weight(self, r)
+
+    return ScaledStress
+
+
+def pull_depth(dim: int, scale: float, beta: float, surface_pairs: bool = False) -> dict:
+    """Where the member's tension and its pull sit in a lattice ball of R/l0 = ``scale`` (l0 =
+    1; numpy, C1-C3 without C4 and C5): the |g|-weighted depth of the tension under the
+    volume's radius, the inward force's weighted depth and its shares at depths 0-1, 1-2 and
+    over 2 l0; with ``surface_pairs``, C3 as ``surface_pairs_member`` has it."""
+    from crowndemo.core.lattice import (LatticeConstants, stress_kernel, stress_pair_kernel,
+                                        stress_pair_support, weight)
+    from crowndemo.scenes.drop import ball
+    from crowndemo.validate.clusters import close_pairs
+    lat = LatticeConstants.compute(dim, 1.0, 2.1, 1.0, 1.0)
+    H = stress_pair_support(dim, 1.0, 2.1)
+    x = ball(dim, scale, 1.0)
+    x = x - x.mean(axis=0)
+    i, j, r2 = close_pairs(x, H, with_d2=True)
+    r, rij = np.sqrt(r2), x[j] - x[i]
+    n = np.zeros(len(x))
+    w = np.where(r < lat.re, weight(np.minimum(r, lat.re), lat.re), 0.0)
+    np.add.at(n, i, w)
+    np.add.at(n, j, w)
+    omega = np.clip((1.0 - n / lat.n0) / (2.0 * (1.0 - beta)), 0.0, 1.0)
+    f = (stress_kernel(r, lat.re) * (r < lat.re))[:, None] * rij
+    g = np.zeros_like(x)
+    np.add.at(g, i, f)
+    np.add.at(g, j, -f)
+    g *= omega[:, None] * lat.stress_K
+    gl = np.linalg.norm(g, axis=1)
+    T = np.zeros((len(x), dim, dim))
+    on = gl > 0
+    T[on] = gl[on, None, None] * np.eye(dim) - g[on, :, None] * g[on, None, :] / gl[on, None, None]
+    fd = stress_pair_kernel(r, H) * np.where(r < 1.0, (r - 0.75) / 0.25, 1.0)
+    if surface_pairs:
+        fd = fd * omega[i] * omega[j] * surface_pairs_ratio(dim, 2.1, beta)
+    pair = np.einsum("kab,kb->ka", T[i] + T[j], rij) * fd[:, None]
+    acc = np.zeros_like(x)
+    np.add.at(acc, i, pair)
+    np.add.at(acc, j, -pair)
+    radius = np.linalg.norm(x, axis=1)
+    depth = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim) - radius
+    pull = -(acc * x).sum(axis=1) / np.maximum(radius, 1e-12)
+    bins = ((0.0, 1.0), (1.0, 2.0), (2.0, np.inf))
+    return {"tension": float((gl * depth).sum() / gl.sum()),
+            "pull": float((pull * depth).sum() / pull.sum()),
+            "shares": [float(pull[(depth >= lo) & (depth < hi)].sum() / pull.sum())
+                       for lo, hi in bins]}
+
+
+def depth(dim: int, scales: str, beta: float) -> None:
+    """``depth``: ``pull_depth`` at each R/l0, the member's C3 and ``--surface-pairs``'s."""
+    for scale in (float(v) for v in scales.split(",")):
+        for pairs in (False, True):
+            d = pull_depth(dim, scale, beta, pairs)
+            print(f"{dim}D lattice ball R/l0 = {scale:g}, C3 " + ("--surface-pairs" if pairs
+                  else "the member's") + f": tension at {d['tension']:.2f} l0 under the volume's "
+                  f"radius, pull at {d['pull']:.2f} l0; the pull's shares at 0-1 / 1-2 / > 2 l0: "
+                  + " / ".join(f"{v:.2f}" for v in d["shares"]))
 
 
 def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1,
@@ -1314,7 +1457,7 @@ def energy(scale: float, relaxed: float, every: int = 5, amplitude: float = 0.1)
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("what", choices=("drop", "case", "stretch", "energy"))
+    ap.add_argument("what", choices=("drop", "case", "stretch", "energy", "depth"))
     ap.add_argument("args", nargs="+")
     ap.add_argument("--base", choices=("first", "member"), default="first",
                     help="first: the first member (1 - (r/re)^4, P = 0 on the surface); "
@@ -1338,6 +1481,10 @@ def main() -> None:
     ap.add_argument("--pair-kernel", choices=tuple(PAIR_KERNELS), default=None,
                     help="the divergence's pair weight (default: the base's)")
     ap.add_argument("--membrane", action="store_true")
+    ap.add_argument("--surface-pairs", action="store_true",
+                    help="C3's pair terms times omega_i omega_j, a rescaled on the lattice")
+    ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
+                    help="the member's tension (a) times F")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--tolman", type=float, default=None,
                     help="C5's delta (l0) for this run's dimension (default: the base's; "
@@ -1396,6 +1543,10 @@ def main() -> None:
     if a.what == "stretch":
         from crowndemo.core import Numerics
         stretch(a.args[0], Numerics().free_surface_beta(2), a.pair_kernel or "quartic")
+        return
+    if a.what == "depth":
+        from crowndemo.core import Numerics
+        depth(int(a.args[0]), a.args[1], Numerics().free_surface_beta(int(a.args[0])))
         return
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
@@ -1467,6 +1618,12 @@ def main() -> None:
         from crowndemo.core import Physics
         factor = c4_factor_value(a.c4_factor, dim, a.re_ratio or Physics.re_ratio)
         member = c4_factor_member(member, factor)
+    if a.surface_pairs:
+        if a.base != "member" or (a.re_ratio or 2.1) != 2.1:
+            raise SystemExit("--surface-pairs: --base member at re = 2.1 l0 only")
+        member = surface_pairs_member(member, dim, 2.1, Numerics().free_surface_beta(dim))
+    if a.tension_factor is not None:
+        member = tension_factor_member(member, a.tension_factor)
     family.MODELS["stress"] = member
     if a.relaxed_start > 0.0 and a.what != "energy" and (
             a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):
