@@ -191,7 +191,7 @@ def test_surface_pairs_normaliser_of_the_study_tools(dim):
     one layer in, the number density's deficit over 2 (1 - beta): in 3D that layer lacks only
     the neighbour two spacings out (w = 2.1/2 - 1), in 2D also none other within 2.1 l0; so
     the weighted sum keeps the face's own pairs and a share omega_1 of its pairs with the
-    layer beneath, and the ratio (a's factor) exceeds 1."""
+    layer beneath, and the ratio (a's factor) exceeds 1 (``product``; ``mean`` less so)."""
     import sys
     sys.path.insert(0, os.path.join(ROOT, "tools"))
     import stress_surface_study as study
@@ -209,3 +209,7 @@ def test_surface_pairs_normaliser_of_the_study_tools(dim):
     assert omega[1] == pytest.approx((2.1 / 2.0 - 1.0) / n0 / (2.0 * (1.0 - beta)), rel=1e-12)
     assert omega[2] == 0.0
     assert study.surface_pairs_ratio(dim, 2.1, beta) > 1.0
+    # the mean weight, (omega_i + omega_j)/2 >= omega_i omega_j for omega in [0, 1], keeps
+    # more of the cut: its factor lies between 1 and the product's
+    assert 1.0 < study.surface_pairs_ratio(dim, 2.1, beta, "mean") < study.surface_pairs_ratio(
+        dim, 2.1, beta, "product")

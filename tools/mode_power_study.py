@@ -6,7 +6,8 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
                           [--sigma-factor S] [--re-ratio X] [--c4-factor F|lattice]
                           [--pair-support H] [--tolman DELTA]
                           [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
-                          [--tolman-lag K] [--surface-pairs] [--tension-factor F]
+                          [--tolman-lag K] [--surface-pairs [product|mean]]
+                          [--tension-factor F]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -215,8 +216,10 @@ def main() -> None:
                     help="--tolman-form lagged: the lag in steps")
     ap.add_argument("--tolman-lag", type=float, default=None, metavar="K",
                     help="C5's lag in capillary times (stress_surface_study --tolman-lag)")
-    ap.add_argument("--surface-pairs", action="store_true",
-                    help="C3's pairs weighted by omega_i omega_j (stress_surface_study's option)")
+    ap.add_argument("--surface-pairs", nargs="?", const="product", default=None,
+                    choices=("product", "mean"),
+                    help="C3's pairs weighted by omega_i omega_j or their mean "
+                    "(stress_surface_study's option)")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
     ap.add_argument("--threads", type=int, default=1)
@@ -268,13 +271,13 @@ def main() -> None:
         from stress_surface_study import tolman_form_member
         family.MODELS["stress"] = tolman_form_member(family.MODELS["stress"], a.tolman_form,
                                                      a.tolman_steps, a.tolman_lag)
-    if a.surface_pairs or a.tension_factor is not None:
+    if a.surface_pairs is not None or a.tension_factor is not None:
         import crowndemo.core.surface_tension as family
         from stress_surface_study import surface_pairs_member, tension_factor_member
-        if a.surface_pairs:
+        if a.surface_pairs is not None:
             family.MODELS["stress"] = surface_pairs_member(
                 family.MODELS["stress"], a.dim, scene.physics.re_ratio,
-                numerics.free_surface_beta(a.dim))
+                numerics.free_surface_beta(a.dim), a.surface_pairs)
         if a.tension_factor is not None:
             family.MODELS["stress"] = tension_factor_member(family.MODELS["stress"],
                                                             a.tension_factor)

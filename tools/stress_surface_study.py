@@ -60,9 +60,10 @@ the particle has, theta = 1 - C |g| l0 (``--theta-slope`` C, fitted on lattice f
 w-weighted mean C4 pressure of its free-surface neighbours outward of it (a third pass);
 ``--continuity``: every fluid particle's pressure is the EOS of a number density carried by the
 continuity equation instead of S17's sum (continuity_pressure_member; a third pass);
-``--surface-pairs`` (``--base member``, re = 2.1 l0): C3's pair terms times omega_i omega_j,
-C1's surface weights, so the pull lands on the surface layer that carries the tension, a
-rescaled on the flat lattice with the same weights (surface_pairs_member; VALIDATION.md "The
+``--surface-pairs [product|mean]`` (``--base member``, re = 2.1 l0): C3's pair terms times
+omega_i omega_j (the default) or (omega_i + omega_j)/2, C1's surface weights, so the pull
+lands on the surface layer that carries the tension, a rescaled on the flat lattice with the
+same weights (surface_pairs_member; VALIDATION.md "The
 mode's stiffness, force by force"); ``--tension-factor F``: the member's a times F;
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
@@ -660,16 +661,25 @@ def _layer_omega(dim: int, re_over_l0: float, beta: float, layers: int) -> np.nd
     return out
 
 
-def surface_pairs_ratio(dim: int, re_over_l0: float, beta: float) -> float:
+SURFACE_PAIRS = ("product", "mean")     # --surface-pairs' weights: omega_i omega_j, their mean
+
+
+def pair_omega(form: str, oi, oj):
+    """A pair's weight of ``--surface-pairs`` from its particles' omega (numpy or Taichi)."""
+    return oi * oj if form == "product" else 0.5 * (oi + oj)
+
+
+def surface_pairs_ratio(dim: int, re_over_l0: float, beta: float, form: str = "product"
+                        ) -> float:
     """a_pairs / a: the flat lattice face's normaliser (lattice.stress_normaliser's cut sum)
-    with each pair's term weighted by omega_i omega_j (``surface_pairs_member``)."""
-    plain, weighted = cut_sums(dim, re_over_l0, beta)
+    with each pair's term weighted by ``pair_omega`` (``surface_pairs_member``)."""
+    plain, weighted = cut_sums(dim, re_over_l0, beta, form)
     return plain / weighted
 
 
-def cut_sums(dim: int, re_over_l0: float, beta: float) -> tuple:
+def cut_sums(dim: int, re_over_l0: float, beta: float, form: str = "product") -> tuple:
     """lattice.stress_normaliser's cut sum over a flat lattice face (l0 = 1; a = 1 / (K_d
-    sum)), plain and with each pair's term times omega_i omega_j of the two layers."""
+    sum)), plain and with each pair's term times ``pair_omega`` of the two layers' omega."""
     from crowndemo.core.lattice import (colour_gradient_column, lattice_offsets,
                                         stress_pair_kernel, stress_pair_support)
     h = stress_pair_support(dim, 1.0, re_over_l0)
@@ -684,17 +694,20 @@ def cut_sums(dim: int, re_over_l0: float, beta: float) -> tuple:
             if off[0] > 0 and kj >= 0:
                 term = off[0] ** 2 * ff * (g[k] + (g[kj] if kj < len(g) else 0.0))
                 plain += term
-                weighted += term * om[k] * om[kj]
+                weighted += term * pair_omega(form, om[k], om[kj])
     return plain, weighted
 
 
-def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float):
-    """``base`` with ``--surface-pairs``: C3's pair terms times omega_i omega_j (C1's surface
-    weights), so the divergence is taken among the particles that carry the tension and the
-    pull lands on the surface layer rather than a spacing under it; a rescaled so that a flat
-    lattice face still carries sigma (``surface_pairs_ratio``). C5's sums as the member's."""
+def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float,
+                         form: str = "product"):
+    """``base`` with ``--surface-pairs FORM``: C3's pair terms times omega_i omega_j
+    (``product``) or (omega_i + omega_j)/2 (``mean``), C1's surface weights, so the divergence
+    is taken among the particles that carry the tension and the pull lands on the surface
+    layer rather than a spacing under it (wholly with the product, half of the next layer's
+    share with the mean); a rescaled so that a flat lattice face still carries sigma
+    (``surface_pairs_ratio``). C5's sums as the member's."""
     from crowndemo.core.surface_tension import stress as S
-    ratio = surface_pairs_ratio(dim, re_over_l0, beta)
+    ratio = surface_pairs_ratio(dim, re_over_l0, beta, form)
 
     @ti.data_oriented
     class SurfacePairsStress(base):
@@ -703,7 +716,10 @@ def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float):
             if self.state.kind[j] != S.GONE:
                 r = ti.sqrt(r2)
                 gi, gj = self.colour[i], self.colour[j]
-                w = ratio * self._surface_weight(i) * self._surface_weight(j)
+                oi, oj = self._surface_weight(i), self._surface_weight(j)
+                w = ratio * 0.5 * (oi + oj)
+                if ti.static(form == "product"):
+                    w = ratio * oi * oj
                 acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r) * w
                 if ti.static(self.delta > 0.0):
                     g_min = S.NORMAL_MIN / self.coef.l0[None]
@@ -727,11 +743,11 @@ def tension_factor_member(base, factor: float):
     return ScaledStress
 
 
-def pull_depth(dim: int, scale: float, beta: float, surface_pairs: bool = False) -> dict:
+def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> dict:
     """Where the member's tension and its pull sit in a lattice ball of R/l0 = ``scale`` (l0 =
     1; numpy, C1-C3 without C4 and C5): the |g|-weighted depth of the tension under the
     volume's radius, the inward force's weighted depth and its shares at depths 0-1, 1-2 and
-    over 2 l0; with ``surface_pairs``, C3 as ``surface_pairs_member`` has it."""
+    over 2 l0; with ``surface_pairs`` (a form), C3 as ``surface_pairs_member`` has it."""
     from crowndemo.core.lattice import (LatticeConstants, stress_kernel, stress_pair_kernel,
                                         stress_pair_support, weight)
     from crowndemo.scenes.drop import ball
@@ -758,7 +774,8 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: bool = False)
     T[on] = gl[on, None, None] * np.eye(dim) - g[on, :, None] * g[on, None, :] / gl[on, None, None]
     fd = stress_pair_kernel(r, H) * np.where(r < 1.0, (r - 0.75) / 0.25, 1.0)
     if surface_pairs:
-        fd = fd * omega[i] * omega[j] * surface_pairs_ratio(dim, 2.1, beta)
+        fd = fd * pair_omega(surface_pairs, omega[i], omega[j]) * surface_pairs_ratio(
+            dim, 2.1, beta, surface_pairs)
     pair = np.einsum("kab,kb->ka", T[i] + T[j], rij) * fd[:, None]
     acc = np.zeros_like(x)
     np.add.at(acc, i, pair)
@@ -776,10 +793,10 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: bool = False)
 def depth(dim: int, scales: str, beta: float) -> None:
     """``depth``: ``pull_depth`` at each R/l0, the member's C3 and ``--surface-pairs``'s."""
     for scale in (float(v) for v in scales.split(",")):
-        for pairs in (False, True):
+        for pairs in ("",) + SURFACE_PAIRS:
             d = pull_depth(dim, scale, beta, pairs)
-            print(f"{dim}D lattice ball R/l0 = {scale:g}, C3 " + ("--surface-pairs" if pairs
-                  else "the member's") + f": tension at {d['tension']:.2f} l0 under the volume's "
+            print(f"{dim}D lattice ball R/l0 = {scale:g}, C3 " + (f"--surface-pairs {pairs}"
+                  if pairs else "the member's") + f": tension at {d['tension']:.2f} l0 under the volume's "
                   f"radius, pull at {d['pull']:.2f} l0; the pull's shares at 0-1 / 1-2 / > 2 l0: "
                   + " / ".join(f"{v:.2f}" for v in d["shares"]))
 
@@ -1481,8 +1498,9 @@ def main() -> None:
     ap.add_argument("--pair-kernel", choices=tuple(PAIR_KERNELS), default=None,
                     help="the divergence's pair weight (default: the base's)")
     ap.add_argument("--membrane", action="store_true")
-    ap.add_argument("--surface-pairs", action="store_true",
-                    help="C3's pair terms times omega_i omega_j, a rescaled on the lattice")
+    ap.add_argument("--surface-pairs", nargs="?", const="product", default=None,
+                    choices=SURFACE_PAIRS, help="C3's pair terms times omega_i omega_j "
+                    "(product) or their mean, a rescaled on the lattice")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
@@ -1621,7 +1639,8 @@ def main() -> None:
     if a.surface_pairs:
         if a.base != "member" or (a.re_ratio or 2.1) != 2.1:
             raise SystemExit("--surface-pairs: --base member at re = 2.1 l0 only")
-        member = surface_pairs_member(member, dim, 2.1, Numerics().free_surface_beta(dim))
+        member = surface_pairs_member(member, dim, 2.1, Numerics().free_surface_beta(dim),
+                                      a.surface_pairs)
     if a.tension_factor is not None:
         member = tension_factor_member(member, a.tension_factor)
     family.MODELS["stress"] = member
