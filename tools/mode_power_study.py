@@ -91,7 +91,7 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
     runs it: each particle's omega from these pairs, a drop's), its zeroth-order part
     (``zeroth``, the sum form's) and the viscous term (the member ``viscosity``: V1 or S12)
     [m/s^2], numpy over the pairs within re (validate/clusters.close_pairs)."""
-    from crowndemo.core.lattice import weight
+    from crowndemo.core.lattice import surface_weight, weight
     from crowndemo.core.pressure import FABRIC_DET_MIN
     from crowndemo.core.viscosity import member
     from crowndemo.validate.clusters import close_pairs
@@ -107,8 +107,7 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
         # M2c: (P_i L_i + P_j L_j) r_ij w / r^2, L_i = omega I + (1 - omega) (tr M_i/d) M_i^-1
         g = (w / r2)[:, None] * rij
         fabric = pair_sum(n, i, j, g[:, :, None] * rij[:, None, :], 1)
-        omega = np.clip((1.0 - pair_sum(n, i, j, w, 1) / n0)
-                        / (2.0 * (1.0 - sim.numerics.free_surface_beta(dim))), 0.0, 1.0)
+        omega = surface_weight(pair_sum(n, i, j, w, 1), n0, sim.numerics.free_surface_beta(dim))
         iso = np.trace(fabric, axis1=1, axis2=2) / dim
         L = np.repeat(np.eye(dim)[None], n, axis=0)
         full = (omega < 1.0) & (iso > 0.0)
@@ -331,16 +330,14 @@ def main() -> None:
         row["q"], row["q_dot"] = mode_coordinate(d, u, G_hat)
         row["M"] = mass * float((xi * xi).sum())
         for name, a_i in acc.items():
-            gen = mass * (a_i * xi).sum(axis=1)
-            row[("Q", name)] = float(gen.sum())
-            for layer, m in zip(layers, masks):
-                row[("Q", name, layer)] = float(gen[m].sum())
-        for name, a_i in acc.items():
             power = mass * (a_i * um).sum(axis=1)
+            gen = mass * (a_i * xi).sum(axis=1)
             row[name] = float(power.sum())
             row[(name, "all")] = mass * float((a_i * u).sum())   # on every particle's motion
+            row[("Q", name)] = float(gen.sum())
             for layer, m in zip(layers, masks):
                 row[(name, layer)] = float(power[m].sum())
+                row[("Q", name, layer)] = float(gen[m].sum())
         rows.append(row)
 
     frames = np.linspace(0.0, scene.t_end, int(round(a.frames * a.periods)) + 1)

@@ -651,14 +651,11 @@ def membrane_member(base, dim: int, ref: float, kernel: str = "quartic"):
 
 def _layer_omega(dim: int, re_over_l0: float, beta: float, layers: int) -> np.ndarray:
     """C1's omega of the layers k = 0, 1, ... of a flat lattice half-space (l0 = 1)."""
-    from crowndemo.core.lattice import lattice_offsets, weight
+    from crowndemo.core.lattice import lattice_offsets, surface_weight, weight
     offs = lattice_offsets(dim, 1.0, re_over_l0)
     w = weight(np.linalg.norm(offs, axis=1), re_over_l0)
-    out = np.zeros(layers)
-    for k in range(layers):
-        n = w[-k + offs[:, -1] <= 1e-6].sum()
-        out[k] = min(max((1.0 - n / w.sum()) / (2.0 * (1.0 - beta)), 0.0), 1.0)
-    return out
+    n = np.array([w[offs[:, -1] <= k + 1e-9].sum() for k in range(layers)])   # layer k's n
+    return surface_weight(n, w.sum(), beta)
 
 
 SURFACE_PAIRS = ("product", "mean")     # --surface-pairs' weights: omega_i omega_j, their mean
@@ -749,7 +746,7 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> 
     volume's radius, the inward force's weighted depth and its shares at depths 0-1, 1-2 and
     over 2 l0; with ``surface_pairs`` (a form), C3 as ``surface_pairs_member`` has it."""
     from crowndemo.core.lattice import (LatticeConstants, stress_kernel, stress_pair_kernel,
-                                        stress_pair_support, weight)
+                                        stress_pair_support, surface_weight, weight)
     from crowndemo.scenes.drop import ball
     from crowndemo.validate.clusters import close_pairs
     lat = LatticeConstants.compute(dim, 1.0, 2.1, 1.0, 1.0)
@@ -762,7 +759,7 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> 
     w = np.where(r < lat.re, weight(np.minimum(r, lat.re), lat.re), 0.0)
     np.add.at(n, i, w)
     np.add.at(n, j, w)
-    omega = np.clip((1.0 - n / lat.n0) / (2.0 * (1.0 - beta)), 0.0, 1.0)
+    omega = surface_weight(n, lat.n0, beta)
     f = (stress_kernel(r, lat.re) * (r < lat.re))[:, None] * rij
     g = np.zeros_like(x)
     np.add.at(g, i, f)
@@ -809,12 +806,8 @@ def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1,
     from crowndemo.core import lattice
     offs = lattice.lattice_offsets(dim, 1.0, re_over_l0)
     r = np.linalg.norm(offs, axis=1)
-    w = lattice.weight(r, re_over_l0)
     column = lattice.colour_gradient_column(dim, 1.0, re_over_l0)
-    g = []
-    for k, gk in enumerate(column):
-        n_k = w[offs[:, -1] <= k + 1e-9].sum() / w.sum()      # layer k's number density
-        g.append(gk * min(max((1.0 - n_k) / (2.0 * (1.0 - beta)), 0.0), 1.0))
+    g = column * _layer_omega(dim, re_over_l0, beta, len(column))
     fd = pair_kernel(kernel)(r, re_over_l0)
     layer = np.round(-offs[:, -1]).astype(int)                  # j's layer, i in layer 0
     tangential = (offs[:, :-1] ** 2).sum(axis=1)
@@ -1196,7 +1189,7 @@ def _strip(s: float, beta: float, re: float, width: int, kernel: str):
     np.fill_diagonal(r, np.inf)
     n = np.where(r < re, re / r - 1.0, 0.0).sum(axis=1)       # number density (S1)
     g = K * (d * np.where(r < re, (1.0 - r / re) ** 3, 0.0)[..., None]).sum(axis=1)   # C1
-    g *= np.clip((1.0 - n / n0) / (2.0 * (1.0 - beta)), 0.0, 1.0)[:, None]
+    g *= lattice.surface_weight(n, n0, beta)[:, None]
     gn = np.linalg.norm(g, axis=1)
     unit = g / np.maximum(gn, 1e-30)[:, None]
     fd = pair_kernel(kernel)(r, re)

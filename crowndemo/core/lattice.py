@@ -78,6 +78,12 @@ def surface_tension_coefficient(dim: int, l0: float, re: float, sigma: float) ->
     return -2.0 * sigma * l0 ** (dim - 1) / cut_potential_sum(dim, l0, re)
 
 
+def surface_weight(n, n0: float, beta: float):
+    """omega = clamp((1 - n/n0) / (2 (1 - beta)), 0, 1) (C1, method.md §4c): numpy's twin of
+    pressure.surface_weight, for the study tools and lattice sums."""
+    return np.clip((1.0 - np.asarray(n, dtype=float) / n0) / (2.0 * (1.0 - beta)), 0.0, 1.0)
+
+
 def stress_kernel(r: np.ndarray, re: float) -> np.ndarray:
     """f(r) = (1 - r/re)^3 for r < re, else 0: the surface-stress model's pair weight (method.md
     §4c, C1): r_ij f(r) is a Wendland C2 kernel's gradient, bounded where w/r^2 is not."""
