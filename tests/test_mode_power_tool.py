@@ -213,3 +213,25 @@ def test_surface_pairs_normaliser_of_the_study_tools(dim):
     # more of the cut: its factor lies between 1 and the product's
     assert 1.0 < study.surface_pairs_ratio(dim, 2.1, beta, "mean") < study.surface_pairs_ratio(
         dim, 2.1, beta, "product")
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_surface_pairs_band_of_the_study_tools(dim):
+    """``--pair-band B`` (tools/stress_surface_study.py): the pairs' omega = clamp((1 -
+    n/n0) / B, 0, 1), so the flat lattice's layer one in (deficit (2.1/2 - 1)/n0, the one
+    neighbour two spacings out it lacks) takes deficit / B, and the face (which lacks half its
+    neighbourhood, a deficit over 1/4) keeps omega 1 at B = 1/4; the wider the band, the less
+    of the face's pairs with that layer the weighted cut keeps, so the larger a's factor."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "tools"))
+    import stress_surface_study as study
+    from crowndemo.core import Numerics
+    from crowndemo.core.lattice import n0_lambda0
+    n0 = n0_lambda0(dim, 1.0, 2.1)[0]
+    band = 0.25
+    omega = study._layer_omega(dim, 2.1, 1.0 - band / 2.0, 3)
+    assert omega[0] == 1.0
+    assert omega[1] == pytest.approx((2.1 / 2.0 - 1.0) / n0 / band, rel=1e-12)
+    own = Numerics().free_surface_beta(dim)
+    assert study.surface_pairs_ratio(dim, 2.1, own, "mean") < study.surface_pairs_ratio(
+        dim, 2.1, 1.0 - band / 2.0, "mean")

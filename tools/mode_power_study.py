@@ -7,7 +7,7 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
                           [--pair-support H] [--tolman DELTA]
                           [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
                           [--tolman-lag K] [--surface-pairs [product|mean]]
-                          [--tension-factor F]
+                          [--pair-band B] [--tension-factor F]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -219,6 +219,9 @@ def main() -> None:
                     choices=("product", "mean"),
                     help="C3's pairs weighted by omega_i omega_j or their mean "
                     "(stress_surface_study's option)")
+    ap.add_argument("--pair-band", type=float, default=0.0, metavar="B",
+                    help="--surface-pairs: the pairs' omega = clamp((1 - n/n0)/B, 0, 1) "
+                         "(stress_surface_study.py; 0: C1's own)")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
     ap.add_argument("--threads", type=int, default=1)
@@ -276,7 +279,7 @@ def main() -> None:
         if a.surface_pairs is not None:
             family.MODELS["stress"] = surface_pairs_member(
                 family.MODELS["stress"], a.dim, scene.physics.re_ratio,
-                numerics.free_surface_beta(a.dim), a.surface_pairs)
+                numerics.free_surface_beta(a.dim), a.surface_pairs, a.pair_band)
         if a.tension_factor is not None:
             family.MODELS["stress"] = tension_factor_member(family.MODELS["stress"],
                                                             a.tension_factor)

@@ -5,7 +5,7 @@ layer does" and after, issue 23), reproducible:
                           [--surface zero|neighbours|virial|own|own-spacing|blend|eos|cumulative]
                           [--pair-kernel quartic|smooth|smooth2|smooth25|smooth3] [--core X]
                           [--isotropic-core]
-                          [--tangential-moment] [--every MS]
+                          [--tangential-moment] [--every MS] [--disorder X]
                           [--membrane [--membrane-ref G]] [--own-factor F] [--own-per-area]
                           [--virial-moment] [--theta-slope C] [--profile]
                           [--tolman DELTA] [--tolman-form pair|particle|smoothed|lagged]
@@ -13,7 +13,8 @@ layer does" and after, issue 23), reproducible:
                           [--tolman-pass DELTA [--tolman-fit]]
                           [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
-                          [--continuity]
+                          [--continuity] [--surface-pairs [product|mean]] [--pair-band B]
+                          [--tension-factor F]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
     .venv/bin/python tools/stress_surface_study.py depth DIM R/l0[,R/l0...]
@@ -64,7 +65,9 @@ continuity equation instead of S17's sum (continuity_pressure_member; a third pa
 omega_i omega_j (the default) or (omega_i + omega_j)/2, C1's surface weights, so the pull
 lands on the surface layer that carries the tension, a rescaled on the flat lattice with the
 same weights (surface_pairs_member; VALIDATION.md "The
-mode's stiffness, force by force"); ``--tension-factor F``: the member's a times F;
+mode's stiffness, force by force"); with it ``--pair-band B``: the pairs' omega = clamp((1 -
+n/n0) / B, 0, 1) rather than C1's band 2 (1 - beta), a rescaled with it (VALIDATION.md "The
+mean weight's unsteady pressure"); ``--tension-factor F``: the member's a times F;
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -114,7 +117,9 @@ rest for P periods (relaxed_start: a liquid without the melt), fitted from t = 0
 ``--pressure-filter``: every step the pressurised particles' EOS pressure is replaced by its
 Shepard mean over the pressurised fluid particles about them (neighbours_pressure_member,
 filtered), before the surface's own; ``--numerics KEY=VALUE``: the drops' params.Numerics
-with KEY set (e.g. collision=0); ``--amplitude A``: ``energy``'s mode amplitude (the case's 0.1);
+with KEY set (e.g. collision=0; ``drop``'s on its own sum form); ``--disorder X``: ``drop``'s
+start disordered as the 3D cases' (0.15; default a lattice); ``--amplitude A``: ``energy``'s
+mode amplitude (the case's 0.1);
 ``--gradient dn``: the pressure gradient's pair term the number density's derivative
 (dn_gradient) instead of S11's.
 ``--pair-kernel``: the divergence's pair weight: ``quartic`` the first member's 1 - (r/re)^4,
@@ -696,24 +701,32 @@ def cut_sums(dim: int, re_over_l0: float, beta: float, form: str = "product") ->
 
 
 def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float,
-                         form: str = "product"):
+                         form: str = "product", band: float = 0.0):
     """``base`` with ``--surface-pairs FORM``: C3's pair terms times omega_i omega_j
     (``product``) or (omega_i + omega_j)/2 (``mean``), C1's surface weights, so the divergence
     is taken among the particles that carry the tension and the pull lands on the surface
     layer rather than a spacing under it (wholly with the product, half of the next layer's
     share with the mean); a rescaled so that a flat lattice face still carries sigma
-    (``surface_pairs_ratio``). C5's sums as the member's."""
+    (``surface_pairs_ratio``). C5's sums as the member's. ``band`` > 0 (``--pair-band B``):
+    the pairs' omega = clamp((1 - n/n0) / B, 0, 1) in place of C1's band 2 (1 - beta) (C1's g
+    unchanged), a from the flat lattice's layers with that band."""
     from crowndemo.core.surface_tension import stress as S
-    ratio = surface_pairs_ratio(dim, re_over_l0, beta, form)
+    from crowndemo.core.pressure import surface_weight
+    pair_beta = beta if band <= 0.0 else 1.0 - 0.5 * band      # the band 2 (1 - beta')
+    ratio = surface_pairs_ratio(dim, re_over_l0, pair_beta, form)
 
     @ti.data_oriented
     class SurfacePairsStress(base):
+        @ti.func
+        def _band_weight(self, i):
+            return surface_weight(self.state.density[i], self.coef.n0[None], pair_beta)
+
         @ti.func
         def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
             if self.state.kind[j] != S.GONE:
                 r = ti.sqrt(r2)
                 gi, gj = self.colour[i], self.colour[j]
-                oi, oj = self._surface_weight(i), self._surface_weight(j)
+                oi, oj = self._band_weight(i), self._band_weight(j)
                 w = ratio * 0.5 * (oi + oj)
                 if ti.static(form == "product"):
                     w = ratio * oi * oj
@@ -740,11 +753,14 @@ def tension_factor_member(base, factor: float):
     return ScaledStress
 
 
-def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> dict:
+def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "",
+               band: float = 0.0) -> dict:
     """Where the member's tension and its pull sit in a lattice ball of R/l0 = ``scale`` (l0 =
     1; numpy, C1-C3 without C4 and C5): the |g|-weighted depth of the tension under the
     volume's radius, the inward force's weighted depth and its shares at depths 0-1, 1-2 and
-    over 2 l0; with ``surface_pairs`` (a form), C3 as ``surface_pairs_member`` has it."""
+    over 2 l0, and the whole inward pull over Laplace's, (d - 1) sigma / R times the area at
+    the volume's radius; with ``surface_pairs`` (a form) and ``band``, C3 as
+    ``surface_pairs_member`` has it."""
     from crowndemo.core.lattice import (LatticeConstants, stress_kernel, stress_pair_kernel,
                                         stress_pair_support, surface_weight, weight)
     from crowndemo.scenes.drop import ball
@@ -771,8 +787,10 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> 
     T[on] = gl[on, None, None] * np.eye(dim) - g[on, :, None] * g[on, None, :] / gl[on, None, None]
     fd = stress_pair_kernel(r, H) * np.where(r < 1.0, (r - 0.75) / 0.25, 1.0)
     if surface_pairs:
-        fd = fd * pair_omega(surface_pairs, omega[i], omega[j]) * surface_pairs_ratio(
-            dim, 2.1, beta, surface_pairs)
+        pair_beta = beta if band <= 0.0 else 1.0 - 0.5 * band
+        om = surface_weight(n, lat.n0, pair_beta)
+        fd = fd * pair_omega(surface_pairs, om[i], om[j]) * surface_pairs_ratio(
+            dim, 2.1, pair_beta, surface_pairs)
     pair = np.einsum("kab,kb->ka", T[i] + T[j], rij) * fd[:, None]
     acc = np.zeros_like(x)
     np.add.at(acc, i, pair)
@@ -781,21 +799,26 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "") -> 
     depth = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim) - radius
     pull = -(acc * x).sum(axis=1) / np.maximum(radius, 1e-12)
     bins = ((0.0, 1.0), (1.0, 2.0), (2.0, np.inf))
-    return {"tension": float((gl * depth).sum() / gl.sum()),
+    R = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim)
+    area = 2.0 * math.pi * R if dim == 2 else 4.0 * math.pi * R * R
+    whole = pull.sum() * lat.stress_Kd * lat.stress_a / ((dim - 1) / R * area)  # sigma = rho = 1
+    return {"tension": float((gl * depth).sum() / gl.sum()), "whole": float(whole),
             "pull": float((pull * depth).sum() / pull.sum()),
             "shares": [float(pull[(depth >= lo) & (depth < hi)].sum() / pull.sum())
                        for lo, hi in bins]}
 
 
-def depth(dim: int, scales: str, beta: float) -> None:
-    """``depth``: ``pull_depth`` at each R/l0, the member's C3 and ``--surface-pairs``'s."""
+def depth(dim: int, scales: str, beta: float, band: float = 0.0) -> None:
+    """``depth``: ``pull_depth`` at each R/l0, the member's C3 and ``--surface-pairs``'s (with
+    ``--pair-band``'s band)."""
     for scale in (float(v) for v in scales.split(",")):
         for pairs in ("",) + SURFACE_PAIRS:
-            d = pull_depth(dim, scale, beta, pairs)
+            d = pull_depth(dim, scale, beta, pairs, band)
             print(f"{dim}D lattice ball R/l0 = {scale:g}, C3 " + (f"--surface-pairs {pairs}"
-                  if pairs else "the member's") + f": tension at {d['tension']:.2f} l0 under the volume's "
-                  f"radius, pull at {d['pull']:.2f} l0; the pull's shares at 0-1 / 1-2 / > 2 l0: "
-                  + " / ".join(f"{v:.2f}" for v in d["shares"]))
+                  if pairs else "the member's") + f": tension at {d['tension']:.2f} l0 under "
+                  f"the volume's radius, pull at {d['pull']:.2f} l0; the pull's shares at 0-1 "
+                  "/ 1-2 / > 2 l0: " + " / ".join(f"{v:.2f}" for v in d["shares"])
+                  + f"; the whole pull {d['whole']:.3f} of Laplace's")
 
 
 def lattice_moment(dim: int, beta: float, re_over_l0: float = 2.1,
@@ -886,14 +909,17 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
     return TangentialMomentStress
 
 
-def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = False) -> None:
-    from crowndemo.core.params import Numerics
+def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = False,
+         changes: dict = None, disorder: float = 0.0) -> None:
+    from crowndemo.core.params import Numerics, with_values
     from crowndemo.scenes.drop import resting_drop
     from crowndemo.validate.cases import simulator
     R, t_end = 1.0e-3, t_ms * 1e-3
     l0 = R / scale
-    scene = resting_drop(dim=dim, radius=R, l0=l0, t_end=t_end, nu=1.0e-4,
-                         numerics=Numerics(pressure_gradient="sum", surface_tension="stress"))
+    numerics = with_values(Numerics(pressure_gradient="sum", surface_tension="stress"),
+                           **(changes or {}))
+    scene = resting_drop(dim=dim, radius=R, l0=l0, t_end=t_end, nu=1.0e-4, numerics=numerics,
+                         disorder=disorder)
     sim = simulator(scene)
     sigma, rho, n0 = sim.physics.sigma, sim.physics.rho, sim.lattice.n0
     laplace = (dim - 1) * sigma / R
@@ -1494,6 +1520,9 @@ def main() -> None:
     ap.add_argument("--surface-pairs", nargs="?", const="product", default=None,
                     choices=SURFACE_PAIRS, help="C3's pair terms times omega_i omega_j "
                     "(product) or their mean, a rescaled on the lattice")
+    ap.add_argument("--pair-band", type=float, default=0.0, metavar="B",
+                    help="--surface-pairs: the pairs' omega = clamp((1 - n/n0)/B, 0, 1) "
+                         "(0: C1's own, B = 2 (1 - beta))")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
@@ -1546,6 +1575,9 @@ def main() -> None:
                          "carried by the continuity equation (continuity_pressure_member)")
     ap.add_argument("--amplitude", type=float, default=0.1,
                     help="energy: the mode's relative amplitude (the case's 0.1)")
+    ap.add_argument("--disorder", type=float, default=0.0, metavar="X",
+                    help="drop: the start's disorder (scenes/drop.resting_drop; the 3D cases' "
+                         "0.15, validate/tension_cases.DISORDER)")
     ap.add_argument("--every", type=float, default=0.5, help="drop: print every EVERY ms")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--profile", action="store_true",
@@ -1557,7 +1589,8 @@ def main() -> None:
         return
     if a.what == "depth":
         from crowndemo.core import Numerics
-        depth(int(a.args[0]), a.args[1], Numerics().free_surface_beta(int(a.args[0])))
+        depth(int(a.args[0]), a.args[1], Numerics().free_surface_beta(int(a.args[0])),
+              a.pair_band)
         return
     backend.init("cpu", threads=a.threads)
     import crowndemo.core.surface_tension as family
@@ -1633,7 +1666,7 @@ def main() -> None:
         if a.base != "member" or (a.re_ratio or 2.1) != 2.1:
             raise SystemExit("--surface-pairs: --base member at re = 2.1 l0 only")
         member = surface_pairs_member(member, dim, 2.1, Numerics().free_surface_beta(dim),
-                                      a.surface_pairs)
+                                      a.surface_pairs, a.pair_band)
     if a.tension_factor is not None:
         member = tension_factor_member(member, a.tension_factor)
     family.MODELS["stress"] = member
@@ -1655,6 +1688,7 @@ def main() -> None:
         assemble = drop_scene.assemble
         drop_scene.assemble = lambda name, physics, *rest: assemble(
             name, _replace(physics, re_ratio=a.re_ratio).validate("--re-ratio"), *rest)
+    changes = {}
     if a.numerics:
         import yaml
         from crowndemo.core.params import with_values
@@ -1663,7 +1697,8 @@ def main() -> None:
         base_numerics = tension_cases.stress_numerics
         tension_cases.stress_numerics = lambda n: with_values(base_numerics(n), **changes)
     if a.what == "drop":
-        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile)
+        drop(int(a.args[0]), float(a.args[1]), float(a.args[2]), a.every, a.profile, changes,
+             a.disorder)
     elif a.what == "energy":
         energy(float(a.args[0]), a.relaxed_start, amplitude=a.amplitude)
     else:
