@@ -273,6 +273,8 @@ def main() -> None:
         from stress_surface_study import tolman_form_member
         family.MODELS["stress"] = tolman_form_member(family.MODELS["stress"], a.tolman_form,
                                                      a.tolman_steps, a.tolman_lag)
+    if a.pair_band and a.surface_pairs is None:
+        raise SystemExit("--pair-band: with --surface-pairs only")
     if a.surface_pairs is not None or a.tension_factor is not None:
         import crowndemo.core.surface_tension as family
         from stress_surface_study import surface_pairs_member, tension_factor_member

@@ -796,10 +796,10 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "",
     np.add.at(acc, i, pair)
     np.add.at(acc, j, -pair)
     radius = np.linalg.norm(x, axis=1)
-    depth = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim) - radius
+    R = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim)  # volume's
+    depth = R - radius
     pull = -(acc * x).sum(axis=1) / np.maximum(radius, 1e-12)
     bins = ((0.0, 1.0), (1.0, 2.0), (2.0, np.inf))
-    R = (len(x) / (math.pi if dim == 2 else 4.0 * math.pi / 3.0)) ** (1.0 / dim)
     area = 2.0 * math.pi * R if dim == 2 else 4.0 * math.pi * R * R
     whole = pull.sum() * lat.stress_Kd * lat.stress_a / ((dim - 1) / R * area)  # sigma = rho = 1
     return {"tension": float((gl * depth).sum() / gl.sum()), "whole": float(whole),
@@ -1583,6 +1583,10 @@ def main() -> None:
     ap.add_argument("--profile", action="store_true",
                     help="drop: P n/n0 over the inside pressure in shells l0/2 thick")
     a = ap.parse_args()
+    if not (math.isfinite(a.pair_band) and 0.0 <= a.pair_band <= 1.0):
+        raise SystemExit(f"--pair-band {a.pair_band}: allowed: 0 (C1's own band) to 1")
+    if a.pair_band > 0.0 and not (a.surface_pairs or a.what == "depth"):
+        raise SystemExit("--pair-band: with --surface-pairs (or depth) only")
     if a.what == "stretch":
         from crowndemo.core import Numerics
         stretch(a.args[0], Numerics().free_surface_beta(2), a.pair_kernel or "quartic")
