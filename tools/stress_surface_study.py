@@ -133,6 +133,7 @@ import contextlib
 import functools
 import math
 import time
+from typing import Optional
 
 import numpy as np
 import taichi as ti
@@ -666,6 +667,12 @@ def _layer_omega(dim: int, re_over_l0: float, beta: float, layers: int) -> np.nd
 SURFACE_PAIRS = ("product", "mean")     # --surface-pairs' weights: omega_i omega_j, their mean
 
 
+def pair_band_beta(beta: float, band: float) -> float:
+    """The beta' whose omega band 2 (1 - beta') is ``--pair-band``'s B (``beta`` itself for B =
+    0), so that surface_weight(n, n0, beta') = clamp((1 - n/n0) / B, 0, 1)."""
+    return beta if band <= 0.0 else 1.0 - 0.5 * band
+
+
 def pair_omega(form: str, oi, oj):
     """A pair's weight of ``--surface-pairs`` from its particles' omega (numpy or Taichi)."""
     return oi * oj if form == "product" else 0.5 * (oi + oj)
@@ -712,7 +719,7 @@ def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float,
     unchanged), a from the flat lattice's layers with that band."""
     from crowndemo.core.surface_tension import stress as S
     from crowndemo.core.pressure import surface_weight
-    pair_beta = beta if band <= 0.0 else 1.0 - 0.5 * band      # the band 2 (1 - beta')
+    pair_beta = pair_band_beta(beta, band)
     ratio = surface_pairs_ratio(dim, re_over_l0, pair_beta, form)
 
     @ti.data_oriented
@@ -787,7 +794,7 @@ def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "",
     T[on] = gl[on, None, None] * np.eye(dim) - g[on, :, None] * g[on, None, :] / gl[on, None, None]
     fd = stress_pair_kernel(r, H) * np.where(r < 1.0, (r - 0.75) / 0.25, 1.0)
     if surface_pairs:
-        pair_beta = beta if band <= 0.0 else 1.0 - 0.5 * band
+        pair_beta = pair_band_beta(beta, band)
         om = surface_weight(n, lat.n0, pair_beta)
         fd = fd * pair_omega(surface_pairs, om[i], om[j]) * surface_pairs_ratio(
             dim, 2.1, pair_beta, surface_pairs)
@@ -910,7 +917,7 @@ def tangential_moment_member(base, beta: float, dim: int, virial: bool = False,
 
 
 def drop(dim: int, scale: float, t_ms: float, every_ms: float, profile: bool = False,
-         changes: dict = None, disorder: float = 0.0) -> None:
+         changes: Optional[dict] = None, disorder: float = 0.0) -> None:
     from crowndemo.core.params import Numerics, with_values
     from crowndemo.scenes.drop import resting_drop
     from crowndemo.validate.cases import simulator
