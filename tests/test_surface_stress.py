@@ -202,16 +202,17 @@ def test_3d_drop_oscillates_at_rayleighs_frequency():
     assert row.error < 0.05
 
 
-def test_half_drop_with_a_mirror_plane_has_the_whole_drops_stress():
+@pytest.mark.parametrize("pairs", ["all", "surface"])
+def test_half_drop_with_a_mirror_plane_has_the_whole_drops_stress(pairs):
     """A resting 2D drop cut by the plane x = 0: with the images (and their mirrored colour
-    gradients, stress._sync_images) every particle of the half has the acceleration it has
-    in the whole drop."""
+    gradients and, with C3's surface pairs, band weights: stress._sync_images) every particle
+    of the half has the acceleration it has in the whole drop."""
     from dataclasses import replace as _replace
 
     from crowndemo.core import simulator_for
     from crowndemo.scenes.drop import resting_drop
     from crowndemo.scenes.symmetric import halve
-    num = Numerics(surface_tension="stress", pressure_gradient="sum")
+    num = Numerics(surface_tension="stress", pressure_gradient="sum", stress_pairs=pairs)
     whole = resting_drop(dim=2, radius=1.0e-3, l0=L0 * 1.25, numerics=num)
     part = halve(_replace(whole, numerics=_replace(num, mirror_planes=(0,))), (0,), [0.0, 0.0])
     out = []

@@ -112,9 +112,10 @@ def test_quick_plan_keeps_every_case_with_one_variant():
     # tests/test_viscosity.py holds the member itself), and the stress drops' wider
     # neighbourhood (another model; tests/test_stress_neighbourhoods.py runs a 2D drop there)
     # and their corrected gradient form (another model; tests/test_corrected_gradient.py holds
-    # its identities)
+    # its identities) and surface pairs (another model; tests/test_stress_surface_pairs.py runs
+    # a 2D drop with them)
     assert every - seen == {"untrimmed", "relative-courant", "lattice", "viscosity=laplacian",
-                            "re=3.1", "gradient=corrected"}
+                            "re=3.1", "gradient=corrected", "surface-pairs"}
     assert set(cases.QUICK_VARIANT) == set(table) - {"crown-base-3m-drop"}
 
 

@@ -7,7 +7,7 @@ VALIDATION.md "Where the mode's energy goes"), reproducible:
                           [--pair-support H] [--tolman DELTA]
                           [--tolman-form pair|particle|smoothed|lagged] [--tolman-steps N]
                           [--tolman-lag K] [--surface-pairs [product|mean]]
-                          [--pair-band B] [--tension-factor F]
+                          [--pair-band B] [--tension-factor F] [--torque-free yes|no]
                           [--threads N]
 
 The drop of the case stress-drop-oscillation-DIMd (validate/tension_cases.py: its start, its
@@ -26,7 +26,8 @@ DELTA: C5's delta in place of the
 neighbourhood's (0 compiles C5 out); --tolman-form / --tolman-steps: C5's probes (s_i on
 i's whole pull, smoothed over the surface, or lagged N steps); --tolman-lag K: the member's
 lag of C5 in capillary times (0: none, the member to 2026-12-07); all as in
-tools/stress_surface_study.py; --surface-pairs, --tension-factor: its options of those names
+tools/stress_surface_study.py; --surface-pairs, --tension-factor, --torque-free: its options
+of those names
 (C3's pairs within the surface layer; the member's tension times F). F frames a period
 (default 40); at each:
 
@@ -92,7 +93,7 @@ def forces(sim, x: np.ndarray, v: np.ndarray, p: np.ndarray,
     (``zeroth``, the sum form's) and the viscous term (the member ``viscosity``: V1 or S12)
     [m/s^2], numpy over the pairs within re (validate/clusters.close_pairs)."""
     from crowndemo.core.lattice import surface_weight, weight
-    from crowndemo.core.pressure import FABRIC_DET_MIN
+    from crowndemo.core.params import FABRIC_DET_MIN
     from crowndemo.core.viscosity import member
     from crowndemo.validate.clusters import close_pairs
     lat, ph = sim.lattice, sim.physics
@@ -224,6 +225,9 @@ def main() -> None:
                          "(stress_surface_study.py; 0: C1's own)")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
+    ap.add_argument("--torque-free", choices=("yes", "no"), default=None,
+                    help="with --numerics stress_pairs=surface: C3b's T_i through L_i or not "
+                         "(stress_surface_study's option)")
     ap.add_argument("--threads", type=int, default=1)
     a = ap.parse_args()
     from crowndemo import backend
@@ -285,6 +289,13 @@ def main() -> None:
         if a.tension_factor is not None:
             family.MODELS["stress"] = tension_factor_member(family.MODELS["stress"],
                                                             a.tension_factor)
+    if a.torque_free is not None:
+        if "stress_pairs=surface" not in a.numerics:
+            raise SystemExit("--torque-free: with --numerics stress_pairs=surface only")
+        import crowndemo.core.surface_tension as family
+        from stress_surface_study import torque_free_member
+        family.MODELS["stress"] = torque_free_member(family.MODELS["stress"],
+                                                     a.torque_free == "yes")
     sim = simulator(scene)
     mass, beta = sim.lattice.mass, numerics.free_surface_beta(a.dim)
     # the mode's shape for the stiffness: xi = G_hat d, G_hat the start's flow's symmetric

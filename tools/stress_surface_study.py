@@ -14,7 +14,7 @@ layer does" and after, issue 23), reproducible:
                           [--nu NU] [--sound-factor F] [--re-ratio X] [--relaxed-start P]
                           [--pressure-filter] [--gradient mps|dn] [--numerics KEY=VALUE ...]
                           [--continuity] [--surface-pairs [product|mean]] [--pair-band B]
-                          [--tension-factor F]
+                          [--tension-factor F] [--torque-free yes|no]
     .venv/bin/python tools/stress_surface_study.py case CASE R/l0[,R/l0...] [the same options]
     .venv/bin/python tools/stress_surface_study.py stretch S[,S...] [--pair-kernel smooth]
     .venv/bin/python tools/stress_surface_study.py depth DIM R/l0[,R/l0...]
@@ -68,6 +68,9 @@ same weights (surface_pairs_member; VALIDATION.md "The
 mode's stiffness, force by force"); with it ``--pair-band B``: the pairs' omega = clamp((1 -
 n/n0) / B, 0, 1) rather than C1's band 2 (1 - beta), a rescaled with it (VALIDATION.md "The
 mean weight's unsteady pressure"); ``--tension-factor F``: the member's a times F;
+``--torque-free yes|no`` (with ``--numerics stress_pairs=surface``): C3b's T_i through L_i
+or not, in place of the neighbourhood's (stress.StressTension.torque_free; VALIDATION.md
+"C3's surface pairs");
 ``--core X``: the repulsive core's zero (stress.CORE, default 0.75);
 ``--isotropic-core``: below the core's zero the pair repels along r_ij with (|g_i| + |g_j|)
 instead of through the tangential projection, so a surface particle cannot sink into a gap;
@@ -657,11 +660,8 @@ def membrane_member(base, dim: int, ref: float, kernel: str = "quartic"):
 
 def _layer_omega(dim: int, re_over_l0: float, beta: float, layers: int) -> np.ndarray:
     """C1's omega of the layers k = 0, 1, ... of a flat lattice half-space (l0 = 1)."""
-    from crowndemo.core.lattice import lattice_offsets, surface_weight, weight
-    offs = lattice_offsets(dim, 1.0, re_over_l0)
-    w = weight(np.linalg.norm(offs, axis=1), re_over_l0)
-    n = np.array([w[offs[:, -1] <= k + 1e-9].sum() for k in range(layers)])   # layer k's n
-    return surface_weight(n, w.sum(), beta)
+    from crowndemo.core.lattice import layer_number_densities, surface_weight
+    return surface_weight(layer_number_densities(dim, re_over_l0, layers), 1.0, beta)
 
 
 SURFACE_PAIRS = ("product", "mean")     # --surface-pairs' weights: omega_i omega_j, their mean
@@ -688,23 +688,14 @@ def surface_pairs_ratio(dim: int, re_over_l0: float, beta: float, form: str = "p
 
 def cut_sums(dim: int, re_over_l0: float, beta: float, form: str = "product") -> tuple:
     """lattice.stress_normaliser's cut sum over a flat lattice face (l0 = 1; a = 1 / (K_d
-    sum)), plain and with each pair's term times ``pair_omega`` of the two layers' omega."""
-    from crowndemo.core.lattice import (colour_gradient_column, lattice_offsets,
-                                        stress_pair_kernel, stress_pair_support)
-    h = stress_pair_support(dim, 1.0, re_over_l0)
-    offs = lattice_offsets(dim, 1.0, h)
-    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
-    g = colour_gradient_column(dim, 1.0, re_over_l0)
-    om = _layer_omega(dim, re_over_l0, beta, len(g) + int(math.ceil(h)) + 1)
-    plain = weighted = 0.0
-    for k in range(len(g)):
-        for off, ff in zip(offs, f):
-            kj = k - int(round(off[-1]))
-            if off[0] > 0 and kj >= 0:
-                term = off[0] ** 2 * ff * (g[k] + (g[kj] if kj < len(g) else 0.0))
-                plain += term
-                weighted += term * pair_omega(form, om[k], om[kj])
-    return plain, weighted
+    sum)), plain and with each pair's term times ``pair_omega`` of the two layers' omega
+    (lattice.stress_cut_sums)."""
+    from crowndemo.core.lattice import (colour_gradient_column, stress_cut_sums,
+                                        stress_pair_support)
+    layers = len(colour_gradient_column(dim, 1.0, re_over_l0)) + int(
+        math.ceil(stress_pair_support(dim, 1.0, re_over_l0))) + 1
+    om = _layer_omega(dim, re_over_l0, beta, layers)
+    return stress_cut_sums(dim, re_over_l0, om, lambda a, b: pair_omega(form, a, b))
 
 
 def surface_pairs_member(base, dim: int, re_over_l0: float, beta: float,
@@ -758,6 +749,16 @@ def tension_factor_member(base, factor: float):
             return factor * base._pair_weight(self, r)
 
     return ScaledStress
+
+
+def torque_free_member(base, on: bool):
+    """``base`` with C3b's pairs torque-free or not (``--torque-free yes|no``: in place of the
+    neighbourhood's choice, stress.StressTension.torque_free)."""
+    @ti.data_oriented
+    class TorqueFreeStress(base):
+        torque_free = on
+
+    return TorqueFreeStress
 
 
 def pull_depth(dim: int, scale: float, beta: float, surface_pairs: str = "",
@@ -1532,6 +1533,9 @@ def main() -> None:
                          "(0: C1's own, B = 2 (1 - beta))")
     ap.add_argument("--tension-factor", type=float, default=None, metavar="F",
                     help="the member's tension (a) times F")
+    ap.add_argument("--torque-free", choices=("yes", "no"), default=None,
+                    help="with --numerics stress_pairs=surface: C3b's T_i through L_i or not "
+                         "(default: the neighbourhood's; stress.StressTension.torque_free)")
     ap.add_argument("--membrane-ref", type=float, default=0.0)
     ap.add_argument("--tolman", type=float, default=None,
                     help="C5's delta (l0) for this run's dimension (default: the base's; "
@@ -1680,6 +1684,10 @@ def main() -> None:
                                       a.surface_pairs, a.pair_band)
     if a.tension_factor is not None:
         member = tension_factor_member(member, a.tension_factor)
+    if a.torque_free is not None:
+        if "stress_pairs=surface" not in a.numerics:
+            raise SystemExit("--torque-free: with --numerics stress_pairs=surface only")
+        member = torque_free_member(member, a.torque_free == "yes")
     family.MODELS["stress"] = member
     if a.relaxed_start > 0.0 and a.what != "energy" and (
             a.what != "case" or a.args[0] != "stress-drop-oscillation-3d"):

@@ -18,25 +18,31 @@ SURFACE_TENSION_WHAT = {
 }
 
 
-def surface_tension_summary(model: str, lat, sigma: float) -> dict:
+def surface_tension_summary(model: str, lat, sigma: float, pairs: str = "all") -> dict:
     """The preset's surface-tension member and its constants (the lattice's, S23 or C1-C3;
     the neighbourhood's C3 pair support H, C4 factor F and C5's delta and lag where delta is
-    not 0)."""
+    not 0; with C3's surface pairs their band B and a's factor, the lattice face's times the
+    measured one)."""
+    what = SURFACE_TENSION_WHAT[model]
     if model == "potential":
         constants = {"C": lat.C}
     elif model == "stress":
-        from ..core.lattice import stress_constants
-        from ..core.params import STRESS_TOLMAN_LAG, stress_pair_support
-        factor, delta = stress_constants(lat.dim, lat.re / lat.l0)
+        from ..core.lattice import stress_constants, stress_pairs_scale
+        from ..core.params import STRESS_SURFACE_BAND, STRESS_TOLMAN_LAG, stress_pair_support
+        ratio = lat.re / lat.l0
+        factor, delta = stress_constants(lat.dim, ratio, pairs)
         constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd,
-                     "H_l0": stress_pair_support(lat.dim, lat.re / lat.l0), "F": factor}
+                     "H_l0": stress_pair_support(lat.dim, ratio), "F": factor}
+        if pairs == "surface":    # C3b (method.md §4c)
+            what += ", C3's pairs weighted by the surface band (C3b)"
+            constants["band_B"] = STRESS_SURFACE_BAND
+            constants["a_factor"] = stress_pairs_scale(lat.dim, ratio, pairs)
         if delta > 0:      # C5's curvature correction (3D; 2D at 3.1 l0)
             constants["delta_l0"] = delta
             constants["lag_capillary_times"] = STRESS_TOLMAN_LAG
     else:
         constants = {}
-    return {"model": model, "what": SURFACE_TENSION_WHAT[model], "sigma_N_m": sigma,
-            "constants": constants}
+    return {"model": model, "what": what, "sigma_N_m": sigma, "constants": constants}
 
 
 def _preset_facts(r, tp) -> Dict:
@@ -78,7 +84,8 @@ def _preset_facts(r, tp) -> Dict:
         "film_over_l0": h / ph.l0, "n0": lat.n0, "lambda0": lat.lambda0,
         "lambda0_over_l0_sq": lat.lambda0 / lat.l0 ** 2, "C": lat.C, "mass": lat.mass,
         "mass_unit": "kg" if ph.dim == 3 else "kg/m (per unit depth)",
-        "surface_tension": surface_tension_summary(r.numerics.surface_tension, lat, ph.sigma),
+        "surface_tension": surface_tension_summary(r.numerics.surface_tension, lat, ph.sigma,
+                                                  r.numerics.stress_pairs),
         "sound_speed_m_s": ph.c,
         "sound_speed_source": s.get("sound_speed_source") or (
             "given" if s.get("sound_speed") is not None else f"{SOUND_SPEED_FACTOR:g} x speed"),
@@ -200,7 +207,7 @@ def info_preset(args) -> int:
     units = {"C": " " + c_unit, "K_1_m2": " 1/m^2", "K_d_1_m2": " 1/m^2", "H_l0": " l0",
              "delta_l0": " l0", "lag_capillary_times": " capillary times"}
     print(f"  tension     {st['model']}: {st['what']}" + "".join(
-        f"; {k.split('_1_')[0].removesuffix('_l0').removesuffix('_capillary_times')} "
+        f"; {k.split('_1_')[0].removesuffix('_l0').removesuffix('_capillary_times').removesuffix('_B')} "
         f"{v:.6g}{units.get(k, '')}"
         for k, v in st["constants"].items()))
     print(f"  sound speed c = {f['sound_speed_m_s']:.4g} m/s ({f['sound_speed_source']})")

@@ -265,6 +265,9 @@ def resolve(doc: Document, quality: str) -> Resolved:
     try:
         model = Model.of(physics, numerics)
     except ParameterError as e:      # the stress member at an re it has no constants for
+        if e.key == "stress_pairs":  # or its surface pairs (C3b)
+            fail("numerics.stress_pairs", e.value, "the stress model's surface pairs (C3b) "
+                 "are calibrated at one neighbourhood only (method.md §4c)", e.allowed)
         fail(e.key, e.value, "the stress model's constants (C4's factor, C5's delta) are "
              "measured at two neighbourhoods only (method.md §4c)", e.allowed)
     _check_mach(scene, numerics, physics, fail, where, derived)

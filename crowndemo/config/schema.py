@@ -23,8 +23,8 @@ import math
 from dataclasses import dataclass
 from typing import Any, Dict, Iterable, Optional, Tuple
 
-from ..core.params import (COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, SURFACE_TENSION_MODELS,
-                           VISCOSITY_MODELS, WALL_MODELS, WATER)
+from ..core.params import (COURANT_SPEEDS, GRADIENT_FORMS, GRAVITY, STRESS_PAIRS,
+                           SURFACE_TENSION_MODELS, VISCOSITY_MODELS, WALL_MODELS, WATER)
 from ..core.symmetry import SYMMETRIES
 from .errors import MISSING, PresetError, did_you_mean
 from .loader import Document
@@ -163,6 +163,10 @@ NUMERICS_KEYS = {
                              "stress (stress, method.md §4c; with pressure_gradient: sum), or "
                              "P = sigma kappa on the free surface (curvature; experimental, "
                              "docs/surface_tension_curvature.md)", choices=SURFACE_TENSION_MODELS),
+    "stress_pairs": Field("choice", "with surface_tension: stress, the divergence's pairs (C3, "
+                          "method.md §4c): all, or surface (weighted by the surface band, "
+                          "calibrated with pressure_gradient: corrected; re_ratio 2.1)",
+                          choices=STRESS_PAIRS),
     "viscosity": Field("choice", "viscosity model (core/viscosity.py): the seed's Laplacian "
                        "(S12), or the central pair form (method.md V1), which dissipates as "
                        "the Navier-Stokes equations at a free surface", choices=VISCOSITY_MODELS),

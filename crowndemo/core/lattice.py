@@ -12,7 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import params
-from .params import STRESS_NEIGHBOURHOODS, ParameterError, stress_neighbourhood
+from .params import (STRESS_NEIGHBOURHOODS, ParameterError, stress_neighbourhood,
+                     stress_surface_pairs)
 
 # l0 at which the lattice sums (l0^-1 .. l0^3, and rho l0^3) stay finite, non-zero floats; a
 # user's spacing is checked against its command's own, narrower range first (cli/info_lattice.py)
@@ -136,26 +137,75 @@ def colour_gradient_column(dim: int, l0: float, re: float) -> np.ndarray:
     return out
 
 
+def layer_number_densities(dim: int, re_ratio: float, layers: int) -> np.ndarray:
+    """n of the layers k = 0 .. layers - 1 of a flat lattice half-space z <= 0 (layer k at z = -k
+    l0, S9) over n0: the free surface's number-density deficit layer by layer."""
+    offs = lattice_offsets(dim, 1.0, re_ratio)
+    w = weight(np.linalg.norm(offs, axis=1), re_ratio)
+    return np.array([w[offs[:, -1] <= k + 1e-9].sum() for k in range(layers)]) / w.sum()
+
+
+def surface_band_weight(n_over_n0, band: float):
+    """omega = clamp((1 - n/n0) / band, 0, 1): the surface pairs' weight of a particle (C3
+    with stress_pairs: surface, method.md §4c); numpy's twin of stress.py's."""
+    return np.clip((1.0 - np.asarray(n_over_n0, dtype=float)) / band, 0.0, 1.0)
+
+
+def stress_cut_sums(dim: int, re_ratio: float, layer_weights=None, pair_weight=None
+                    ) -> tuple[float, float]:
+    """The sum form's (C3) cut sum across a flat lattice face, l0 = 1: sum_k sum_{r_x > 0} r_x^2
+    f_d(r) (|g_k| + |g_k'|) over the face's layers k and their partners j = i + r in layer k'
+    (|r| < H), as it is and with each term times the pair's weight, pair_weight(w_k, w_k')
+    (default their mean, C3's surface pairs) of ``layer_weights`` (w of the layers k = 0, 1,
+    ...; None: the plain sum twice)."""
+    h = stress_pair_support(dim, 1.0, re_ratio)
+    offs = lattice_offsets(dim, 1.0, h)
+    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
+    g = colour_gradient_column(dim, 1.0, re_ratio)
+    m = len(g) - 1
+    if layer_weights is None:
+        layer_weights = np.ones(m + int(math.ceil(h)) + 2)
+    plain = weighted = 0.0
+    for k in range(m + 1):
+        for off, ff in zip(offs, f):
+            kj = k - int(round(off[-1]))           # j's layer (z_j = -kj)
+            if off[0] > 0 and kj >= 0:
+                gj = g[kj] if kj <= m else 0.0
+                term = off[0] ** 2 * ff * (g[k] + gj)
+                plain += term
+                wk, wj = layer_weights[k], layer_weights[kj]
+                weighted += term * (0.5 * (wk + wj) if pair_weight is None
+                                    else pair_weight(wk, wj))
+    return plain, weighted
+
+
 def stress_normaliser(dim: int, l0: float, re: float) -> float:
     """a of the surface-stress model (method.md §4c, C2): the factor that makes the flat
     lattice surface carry sigma. Across a cut normal to x through the half-space, the sum form
     of the divergence (C3) transmits, per unit length of the surface (and depth in 2D),
     a sigma l0 K_d sum_k sum_{r_x > 0} r_x^2 f_d(r) (|g_k| + |g_k'|) (j = i + r in layer k',
-    |r| < H); a makes that sigma. Dimensionless."""
-    h = stress_pair_support(dim, l0, re / l0)
-    offs = lattice_offsets(dim, l0, h)
-    f = stress_pair_kernel(np.linalg.norm(offs, axis=1), h)
-    K = stress_gradient_norm(dim, l0, re, stress_pair_kernel, h)
-    g = colour_gradient_column(dim, l0, re)
-    m = len(g) - 1
-    total = 0.0
-    for k in range(m + 1):
-        for off, ff in zip(offs, f):
-            kj = k - int(round(off[-1] / l0))           # j's layer (z_j = -kj l0)
-            if off[0] > 0 and kj >= 0:
-                gj = g[kj] if kj <= m else 0.0
-                total += off[0] ** 2 * ff * (g[k] + gj)
-    return 1.0 / (l0 * K * total)
+    |r| < H; ``stress_cut_sums``); a makes that sigma. Dimensionless (l0 = 1 here)."""
+    ratio = re / l0
+    K = stress_gradient_norm(dim, 1.0, ratio, stress_pair_kernel,
+                             stress_pair_support(dim, 1.0, ratio))
+    return 1.0 / (K * stress_cut_sums(dim, ratio)[0])
+
+
+def _surface_layers(dim: int, re_ratio: float, band: float) -> np.ndarray:
+    """C3b's omega of a flat lattice face's layers k = 0, 1, ... (as many as its cut sum
+    reaches)."""
+    layers = len(colour_gradient_column(dim, 1.0, re_ratio)) + int(
+        math.ceil(stress_pair_support(dim, 1.0, re_ratio))) + 1
+    return surface_band_weight(layer_number_densities(dim, re_ratio, layers), band)
+
+
+def surface_pairs_ratio(dim: int, re_ratio: float, band: float) -> float:
+    """a's factor with stress_pairs: surface (C3b: C3's pairs times the mean of their
+    particles' ``surface_band_weight``): the flat lattice face's plain cut sum over its
+    weighted one, so that the face still carries sigma (C3b's L_i has a mean gain of 1 along
+    the face, so it adds nothing here)."""
+    plain, weighted = stress_cut_sums(dim, re_ratio, _surface_layers(dim, re_ratio, band))
+    return plain / weighted
 
 
 def face_balance_factor(dim: int, re_ratio: float) -> float:
@@ -171,14 +221,28 @@ def face_balance_factor(dim: int, re_ratio: float) -> float:
     return float(w.sum()) / (2 * dim * G)
 
 
-def stress_constants(dim: int, re_ratio: float) -> tuple[float, float]:
-    """The stress member's (C4's F, C5's delta in l0) at ``re_ratio``
-    (params.STRESS_NEIGHBOURHOODS; a ParameterError for a neighbourhood it has none for)."""
+def stress_constants(dim: int, re_ratio: float, pairs: str = "all") -> tuple[float, float]:
+    """The stress member's (C4's F, C5's delta in l0) at ``re_ratio`` with C3's ``pairs``
+    (params.STRESS_NEIGHBOURHOODS, STRESS_PAIRS; a ParameterError for a neighbourhood it has
+    none for)."""
     own = STRESS_NEIGHBOURHOODS[stress_neighbourhood(re_ratio)]
     factor = own["c4_factor"][dim]
     if factor == "lattice":
         factor = face_balance_factor(dim, re_ratio)
-    return float(factor), float(own["tolman"][dim])
+    if pairs != "all":
+        own = stress_surface_pairs(re_ratio)
+    delta = own["tolman"][dim]
+    return float(factor), float(delta)
+
+
+def stress_pairs_scale(dim: int, re_ratio: float, pairs: str = "all") -> float:
+    """a's factor for C3's ``pairs``: 1 for all of them; for the surface pairs the flat lattice
+    face's (``surface_pairs_ratio``, so the face carries sigma) times the tension factor that
+    the neighbourhood measured on drops (params.STRESS_NEIGHBOURHOODS' "surface_pairs")."""
+    if pairs == "all":
+        return 1.0
+    return surface_pairs_ratio(dim, re_ratio, params.STRESS_SURFACE_BAND) * float(
+        stress_surface_pairs(re_ratio)["factor"][dim])
 
 
 @dataclass(frozen=True)

@@ -54,11 +54,30 @@ VISCOUS_STIFFNESS = {"laplacian": 1.0, "central": 3.0}
 # (VALIDATION.md, "C5's own damping", "C5 lagged in the surface's capillary time")
 STRESS_TOLMAN_LAG = 3.5
 STRESS_NEIGHBOURHOODS = {2.1: {"pair_support": {2: 3.0, 3: 3.0}, "c4_factor": {2: 1.0, 3: 1.0},
-                               "tolman": {2: 0.0, 3: 0.80}},
+                               "tolman": {2: 0.0, 3: 0.80},
+                               "surface_pairs": {"factor": {2: 1.22, 3: 1.34},
+                                                 "tolman": {2: 0.0, 3: 0.0},
+                                                 "torque_free": {2: True, 3: False}}},
                          3.1: {"pair_support": {2: 3.0, 3: 4.1},
                                "c4_factor": {2: "lattice", 3: 1.0},
                                "tolman": {2: 0.9, 3: 1.25}}}
 SEED_NEIGHBOURHOOD = 2.1
+# C3's pairs (method.md §4c, stress.py): "all" weighs every pair of the divergence alike (the
+# member as it was to 2026-12-08); "surface" weighs each by the mean of its two particles'
+# band weights clamp((1 - n/n0) / STRESS_SURFACE_BAND, 0, 1), so the pull lands on the surface
+# layer rather than a spacing under it and the layer stays full (VALIDATION.md, "The mean
+# weight's unsteady pressure"). Its constants are a neighbourhood's "surface_pairs": a factor
+# on the tension measured on the drops with pressure_gradient: corrected, C5's delta (0: off),
+# and whether each T_i goes through its L_i (stress.py, 2b), which takes the weighted pairs'
+# torque out: in 2D, where without it free drops turned 0.06-0.14 rad in 10 periods at R/l0
+# = 8 and 16, not in 3D, where the drops held still without it and with it the mode decayed
+# at 0.65 of the viscous rate (VALIDATION.md "C3's surface pairs"). Only the neighbourhoods
+# that have them admit it.
+STRESS_PAIRS = ("all", "surface")
+# the band: a flat lattice face (deficit 0.27 / 0.32 in 3D / 2D) weighs 1, the layer under it
+# 0.014 / 0.031 (C1's band 2 (1 - beta) = 0.04 / 0.06 made a particle a spacing in half a
+# surface particle as soon as its n fell 2-3 % under n0)
+STRESS_SURFACE_BAND = 0.25
 
 
 def _neighbourhood_key(re_ratio: float) -> Optional[float]:
@@ -80,6 +99,18 @@ def stress_neighbourhood(re_ratio: float, source: str = "parameters") -> float:
     return key
 
 
+def stress_surface_pairs(re_ratio: float, source: str = "parameters") -> dict:
+    """The "surface_pairs" constants of the neighbourhood ``re_ratio``, or a ParameterError
+    naming stress_pairs where it has none."""
+    own = STRESS_NEIGHBOURHOODS[stress_neighbourhood(re_ratio, source)]
+    if "surface_pairs" not in own:
+        with_pairs = [f"{k:g}" for k, v in STRESS_NEIGHBOURHOODS.items() if "surface_pairs" in v]
+        raise ParameterError("stress_pairs", "surface", "all, or surface at re_ratio "
+                             + " or ".join(with_pairs) + f" (re_ratio is {re_ratio:g})",
+                             source)
+    return own["surface_pairs"]
+
+
 def stress_pair_support(dim: int, re_ratio: float) -> float:
     """C3's pair support H/l0 in ``dim`` at ``re_ratio``: its neighbourhood's, or the seed
     neighbourhood's where it has none (the other members, which compile as at 2.1 l0)."""
@@ -87,6 +118,11 @@ def stress_pair_support(dim: int, re_ratio: float) -> float:
     own = STRESS_NEIGHBOURHOODS[SEED_NEIGHBOURHOOD if key is None else key]
     return float(own["pair_support"][dim])
 
+
+# M2c (pressure.py) and C3b (stress.py): L_i = I where the fabric is degenerate, det M_i <
+# FABRIC_DET_MIN (tr M_i / d)^d (a particle with its neighbours on a line or a plane; a
+# half-space's face reads 0.86 in 3D)
+FABRIC_DET_MIN = 0.05
 
 # the seed's water (method.md §6) and gravity, the defaults wherever a liquid is not given
 WATER = {"rho": 998.0, "nu": 1.0e-6, "sigma": 0.0728}     # kg/m^3, m^2/s, N/m
@@ -156,6 +192,7 @@ class Numerics:
     allow_unsafe_dt: bool = False   # only for tests that force an unstable run
     pressure_gradient: str = "pmin"
     surface_tension: str = "potential"   # SURFACE_TENSION_MODELS; compiled in when sigma > 0
+    stress_pairs: str = "all"       # STRESS_PAIRS: C3's pairs with surface_tension: stress
     viscosity: str = "laplacian"    # VISCOSITY_MODELS; compiled in when nu > 0
     beta: Optional[float] = None    # free-surface threshold n < beta n0 (M3); None: 0.97/0.98
     max_density_excess: float = 0.5  # abort when n/n0 - 1 exceeds this
@@ -200,6 +237,7 @@ class Numerics:
         need(self.surface_tension in SURFACE_TENSION_MODELS, "surface_tension",
              " | ".join(SURFACE_TENSION_MODELS))
         need(self.viscosity in VISCOSITY_MODELS, "viscosity", " | ".join(VISCOSITY_MODELS))
+        need(self.stress_pairs in STRESS_PAIRS, "stress_pairs", " | ".join(STRESS_PAIRS))
         need(self.beta is None or 0.5 <= self.beta < 1.0, "beta", "0.5 <= beta < 1")
         need(self.max_density_excess > 0, "max_density_excess", "> 0")
         need(self.max_mach > 0, "max_mach", "> 0")
@@ -249,13 +287,15 @@ class Model:
     # re/l0 whose constants the stress member compiles in (STRESS_NEIGHBOURHOODS); the seed's
     # 2.1 for the other members, so a simulator of theirs serves any re (control.Session)
     stress_re_ratio: float = Physics.re_ratio
+    stress_pairs: str = "all"        # C3's pairs (STRESS_PAIRS), "all" for the other members
 
     @classmethod
     def of(cls, physics: Physics, numerics: Numerics) -> "Model":
-        """What ``physics`` and ``numerics`` compile in; a ParameterError (re_ratio) where the
-        stress member is chosen at a neighbourhood it has no constants for."""
+        """What ``physics`` and ``numerics`` compile in; a ParameterError (re_ratio, or
+        stress_pairs) where the stress member, or its surface pairs, is chosen at a
+        neighbourhood it has no constants for."""
         stress = physics.sigma > 0 and numerics.surface_tension == "stress"
-        return cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
+        model = cls(physics.dim, physics.nu > 0, physics.sigma > 0, physics.gravity != 0,
                    numerics.pressure_gradient, numerics.collision > 0, numerics.neighbour_list,
                    numerics.cells_per_re, numerics.wall_model == "plane",
                    numerics.courant_speed == "relative", tuple(numerics.mirror_planes),
@@ -265,7 +305,11 @@ class Model:
                        / physics.re_ratio)
                    if stress else 1.0,
                    numerics.viscosity,
-                   stress_neighbourhood(physics.re_ratio) if stress else Physics.re_ratio)
+                   stress_neighbourhood(physics.re_ratio) if stress else Physics.re_ratio,
+                   numerics.stress_pairs if stress else "all")
+        if model.stress_pairs == "surface":
+            stress_surface_pairs(physics.re_ratio)      # refused where it has no constants
+        return model
 
     def describe(self) -> dict:
         return {"viscosity": self.viscosity, "surface_tension": self.surface_tension,
@@ -276,7 +320,7 @@ class Model:
                 "mirror_planes": list(self.mirror_planes),
                 "predictor_list": self.predictor_list,
                 "surface_tension_model": self.surface_tension_model,
-                "viscosity_model": self.viscosity_model}
+                "viscosity_model": self.viscosity_model, "stress_pairs": self.stress_pairs}
 
 
 def _finite(x) -> bool:
@@ -296,5 +340,5 @@ def with_values(obj: _Params, **changes: Any) -> _Params:
 
 
 __all__ = ["Physics", "Numerics", "Model", "ParameterError", "GRADIENT_FORMS", "WALL_MODELS",
-           "COURANT_SPEEDS", "SURFACE_TENSION_MODELS", "VISCOSITY_MODELS", "VISCOUS_STIFFNESS",
-           "with_values"]
+           "COURANT_SPEEDS", "SURFACE_TENSION_MODELS", "STRESS_PAIRS", "VISCOSITY_MODELS",
+           "VISCOUS_STIFFNESS", "with_values"]

@@ -19,13 +19,10 @@ from .coefficients import Coefficients
 from .grid import CellGrid
 from .neighbours import NeighbourList
 from .operators import gradient_pair, make_density_task, weight
-from .params import Model
+from .params import FABRIC_DET_MIN, Model
 from .plane_floor import FLOOR_G, FLOOR_N, PlaneFloor
 from .state import DUMMY, FLUID, WALL
 
-# M2c: L_i = I where the fabric is degenerate, det M_i < FABRIC_DET_MIN (tr M_i / d)^d (a
-# particle with its neighbours on a line or a plane; a half-space's face reads 0.86 in 3D)
-FABRIC_DET_MIN = 0.05
 
 
 @ti.func

@@ -91,6 +91,7 @@ ADDED_KEYS = {
     ("crown", "numerics", "predictor_list"): SAME,        # 61e0a5a
     ("crown", "numerics", "surface_tension"): "potential",  # fa57f31
     ("crown", "numerics", "viscosity"): "laplacian",      # f50bdf2
+    ("crown", "numerics", "stress_pairs"): "all",         # C3b, 2026-12-08
     ("crown", "symmetry"): "full",                        # e651047
     ("crown", "trim_reach"): 2.0,                         # e651047 (crown.TRIM_REACH)
 }

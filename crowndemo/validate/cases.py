@@ -397,6 +397,8 @@ def variant_numerics(variant: str, numerics: Numerics) -> Numerics:
         return replace(numerics, pressure_gradient=variant.split("=", 1)[1])
     if variant.startswith("viscosity="):   # the viscosity member (core/viscosity.py)
         return replace(numerics, viscosity=variant.split("=", 1)[1])
+    if variant == "surface-pairs":      # the stress member's surface pairs (C3b), corrected form
+        return replace(numerics, stress_pairs="surface", pressure_gradient="corrected")
     if variant == "plane-floor":        # the analytic floor instead of its particle layers
         return replace(numerics, wall_model="plane")
     if variant == "relative-courant":   # the crown presets' Courant limit (core/terms.py)

@@ -11,7 +11,9 @@ run the central viscosity (core/viscosity.py, method.md V1), which dissipates La
 a free surface where the seed's Laplacian dissipates half; with it the 3D mode-2 frequency
 read within 2.1 % at R/l0 = 8-14 against the Laplacian's +4-5 % from 12 on (VALIDATION.md,
 "The viscosity at a free surface"); their variant ``viscosity=laplacian`` runs the seed's.
-Every case has the variant ``re=3.1``: the member on its wider calibrated neighbourhood.
+Every case has the variant ``re=3.1``: the member on its wider calibrated neighbourhood, and
+``surface-pairs``: C3's pairs weighted by the surface band (``numerics.stress_pairs:
+surface``, method.md C3b) with the corrected form.
 """
 from __future__ import annotations
 
@@ -49,6 +51,10 @@ WIDE = "re=3.1"
 # takes the decay's excess out and the frequency down (VALIDATION.md, "The fabric's shear
 # stress")
 CORRECTED = "gradient=corrected"
+# The variant with C3's surface pairs (stress_pairs: surface, method.md C3b) and the corrected
+# form, with which they were calibrated: the pull on the surface layer, the layer full and the
+# pressure steady, the decay the viscous mode's (VALIDATION.md, "C3's surface pairs")
+SURFACE = "surface-pairs"
 
 
 def mode2_period(dim: int) -> float:
@@ -170,7 +176,7 @@ def _laplace(dim: int) -> Case:
                 (8, 12, 16), (12,) if dim == 2 else (8,), lambda s: R / s, run,
                 variants=(("gradient=pmin", "gradient=seed") if dim == 2 else ("gradient=pmin",
                                                                                "lattice"))
-                + (WIDE, CORRECTED),
+                + (WIDE, CORRECTED, SURFACE),
                 base=stress_numerics)
 
 
@@ -207,7 +213,7 @@ def _oscillation(dim: int) -> Case:
                 "Rayleigh-Lamb (method.md §7)", "R/l0",
                 (8, 12, 16) if dim == 2 else (8, 10, 12), (8,), lambda s: R / s, run,
                 variants=("gradient=pmin", "safety/2") + (("lattice",) if dim == 3 else ())
-                + ("viscosity=laplacian", WIDE, CORRECTED), base=oscillation_numerics)
+                + ("viscosity=laplacian", WIDE, CORRECTED, SURFACE), base=oscillation_numerics)
 
 
 def _free_drop(dim: int) -> Case:
@@ -235,7 +241,7 @@ def _free_drop(dim: int) -> Case:
                 "surface stress: centre-of-mass drift over 10 mode-2 periods / R",
                 "0 (a free drop holds still; issue 23: < 0.01 R, turn < 0.05 rad)", "R/l0",
                 (8, 12, 16), (8,), lambda s: R / s, run,
-                variants=("gradient=pmin", "gradient=seed", WIDE, CORRECTED),
+                variants=("gradient=pmin", "gradient=seed", WIDE, CORRECTED, SURFACE),
                 base=stress_numerics)
 
 

@@ -39,6 +39,30 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    particles pulled together met no pressure until n > n0, then a third one's arrival kicked
    one out of a resting drop at 0.2-0.4 m/s. The idea is the repulsive core of the seed's
    potential (S22, r < l0) and Monaghan's (2000) cure for the tensile instability;
+2b. with ``numerics.stress_pairs: surface`` (C3b), each pair's term times the mean of its
+   particles' band weights, w_ij = (omega_i + omega_j)/2, omega = clamp((1 - n/n0)/B, 0, 1),
+   B = params.STRESS_SURFACE_BAND = 0.25 (0 for walls and dummies): (s_i T_i + s_j T_j) r_ij
+   w_ij f_d, a times the flat lattice face's ratio of its plain cut sum to its weighted one
+   (lattice.surface_pairs_ratio: 1.32 / 1.29 in 2D / 3D) and the factor measured on drops
+   with the corrected gradient form (params.STRESS_NEIGHBOURHOODS' "surface_pairs"; C5 off).
+   A flat face weighs 1, the layer under it 0.03 / 0.014, so the pull lands on the surface
+   layer (with C3 a quarter of it lands a spacing under it, where it reads the inside
+   pressure high and restores a mode weakly); with C1's narrower band 2 (1 - beta) a particle
+   a spacing in turned half a surface particle as soon as its n fell 2-3 % under n0, the
+   surface layer emptied and the inside pressure swung by a sawtooth (VALIDATION.md, "The
+   mean weight's unsteady pressure", "C3's surface pairs"). The pair's weight is its own, so
+   the pairs stay antisymmetric; but the weighted pairs see mostly the surface layer, a
+   fabric far from isotropic, and on a rough surface T_i M_i (M_i = sum_j w_ij f_d r_ij
+   r_ij^T) is not symmetric: the pairs exert a torque, which turned a free 2D drop by 0.06 /
+   0.14 rad in 10 periods at R/l0 = 8 (sum / corrected form) and 0.057 at 16 (corrected). In
+   2D (the neighbourhood's "torque_free") each T_i goes through L_i = M_i^-1 (d - 1) /
+   tr_t(M_i^-1), tr_t the trace in T_i's tangent plane (M_i summed in pass 1, which then
+   walks to H where omega_i > 0; I where M_i is degenerate), so that T_i L_i M_i is symmetric
+   (the idea of M2c and of Bonet & Lok's 1999 corrected gradient) and L_i's mean gain along
+   the surface is 1: the pairs exert no torque and the free drops hold still. Not in 3D,
+   whose free drop held still without it: there L_i, following the fabric's strain in the
+   mode, fed it, and the drop's mode decayed at 0.65 of the viscous rate, 5 % slow (the
+   class attribute ``torque_free`` sets either for a study);
 3. the free surface's pressure (C4): a fluid particle that S17/M3 left at P = 0 and that has a
    colour gradient takes the normal stress its own tension carries,
    P_i = F rho l0 max(0, a_i . g_i/|g_i|),
@@ -88,8 +112,8 @@ import taichi as ti
 from ..coefficients import Coefficients
 from ..grid import CellGrid
 from .. import params
-from ..lattice import stress_constants
-from ..params import Model
+from ..lattice import stress_constants, stress_pairs_scale
+from ..params import FABRIC_DET_MIN, Model
 from ..pressure import surface_weight
 from ..state import FLUID, GONE, field_nbytes
 
@@ -119,6 +143,13 @@ def stress_pair_kernel(r, h, l0):
     if r < l0:
         f *= (r / l0 - CORE) / (1.0 - CORE)
     return f
+
+
+@ti.func
+def band_weight(n, n0):
+    """C3b's omega = clamp((1 - n/n0) / B, 0, 1), B = params.STRESS_SURFACE_BAND
+    (lattice.surface_band_weight)."""
+    return ti.min(ti.max((1.0 - n / n0) / params.STRESS_SURFACE_BAND, 0.0), 1.0)
 
 
 @ti.func
@@ -165,6 +196,10 @@ class StressTension:
     c4_factor = None
     tolman_delta = None
     tolman_lag = None          # C5's lag in capillary times: None takes TOLMAN_LAG, 0 none
+    # C3b's pairs torque-free, each T_i through L_i (module docstring, 2b): None takes the
+    # neighbourhood's (params.STRESS_NEIGHBOURHOODS' "surface_pairs": 2D yes, 3D no), a study
+    # sets it (tools/stress_surface_study.py --torque-free yes|no)
+    torque_free = None
 
     def __init__(self, model: Model, grid: CellGrid, coef: Coefficients):
         self.model, self.grid, self.coef, self.state = model, grid, coef, grid.state
@@ -173,7 +208,21 @@ class StressTension:
         self.colour = ti.Vector.field(self.dim, float, cap)   # g_i (C1) [1/m]
         self.accel = ti.Vector.field(self.dim, float, cap)    # a_i (C3) [m/s^2]
         self.floor = None        # the analytic plane floor, where the model has one
-        factor, delta = stress_constants(self.dim, model.stress_re_ratio)
+        factor, delta = stress_constants(self.dim, model.stress_re_ratio, model.stress_pairs)
+        # C3's pairs: all alike, or weighted by the surface band (C3b); a times the lattice
+        # face's factor and the measured one with the latter (lattice.stress_pairs_scale)
+        self.surface_pairs = model.stress_pairs == "surface"
+        self.pairs_scale = stress_pairs_scale(self.dim, model.stress_re_ratio, model.stress_pairs)
+        self.fabric = None
+        torque_free = self.torque_free
+        if self.surface_pairs and torque_free is None:
+            torque_free = params.stress_surface_pairs(model.stress_re_ratio)["torque_free"][
+                self.dim]
+        self.torque_pairs = self.surface_pairs and bool(torque_free)
+        if self.torque_pairs:      # C3b's L_i, pass 1's (I where T_i = 0)
+            self.fabric = ti.Matrix.field(self.dim, self.dim, float, cap)
+        self.colour_sums = ti.types.struct(g=ti.types.vector(self.dim, float),
+                                           m=ti.types.matrix(self.dim, self.dim, float))
         # C3's pair support H / l0, the neighbourhood's (compiled in)
         self.pair_support = params.stress_pair_support(self.dim, model.stress_re_ratio)
         self.surface_factor = factor if self.c4_factor is None else float(self.c4_factor)
@@ -195,13 +244,19 @@ class StressTension:
 
     def nbytes(self) -> int:
         own = [self.colour, self.accel] + ([self.tolman, self.tolman_next] if self.delta > 0.0
-                                           else [])
+                                           else []) + ([self.fabric] if self.fabric is not None
+                                                       else [])
         return sum(field_nbytes(f) for f in own)
 
     def boundary_pressure(self, dt: float = 0.0) -> None:
         """The two passes (module docstring), then the free surface's pressure (C4) and C5's
         s_i for the next step, its lag advanced by ``dt`` (0: output, nothing advances)."""
-        self._colour()
+        if self.surface_pairs and self.symmetry is not None:
+            self.symmetry.sync_pressure()     # C3b weighs images by their n: theirs now
+        if self.fabric is not None:
+            self._colour_fabric()
+        else:
+            self._colour()
         if self.symmetry is not None:
             self._sync_images()
         self._divergence()
@@ -226,6 +281,54 @@ class StressTension:
             self.colour[i] = self._surface_weight(i) * self.coef.stress_K[None] * g
 
     @ti.func
+    def _band(self, j):
+        """C3b's omega_j (band_weight of its number density), 0 for walls and dummies."""
+        return ti.select(self.state.kind[j] == FLUID,
+                         band_weight(self.state.density[j], self.coef.n0[None]), 0.0)
+
+    @ti.func
+    def _colour_fabric_pair(self, i, j, rij, r2, acc: ti.template()):
+        """C1's term within re, and C3b's weighted fabric over pass 2's own pairs to H."""
+        if self.state.kind[j] != GONE:
+            r = ti.sqrt(r2)
+            if r2 < self.coef.re2[None]:
+                acc.g += rij * stress_kernel(r, self.coef.re[None])
+            acc.m += (0.5 * (self._band(i) + self._band(j)) * self._pair_weight(r)
+                      ) * rij.outer_product(rij)
+
+    @ti.kernel
+    def _colour_fabric(self):
+        """Pass 1 with C3b: g_i as ``_colour`` (walked only where omega_i > 0: elsewhere g_i
+        = 0), and L_i = M_i^-1 (d - 1) / tr_t(M_i^-1) of the weighted fabric M_i = sum_j w_ij
+        f_d r_ij r_ij^T over pass 2's pairs, tr_t the trace in T_i's tangent plane (I where M_i
+        is degenerate or T_i = 0), so that T_i L_i M_i is symmetric (the pairs exert no
+        torque) and L_i's mean gain along the surface is 1 (T_i's size unchanged)."""
+        reach2 = (self.pair_support * self.coef.l0[None]) ** 2
+        for at in range(self.state.n[None]):
+            i = self.state.spread(at)
+            acc = self.colour_sums(g=ti.Vector.zero(float, self.dim),
+                                   m=ti.Matrix.zero(float, self.dim, self.dim))
+            correction = ti.Matrix.identity(float, self.dim)
+            omega = 0.0
+            if self.state.kind[i] == FLUID:
+                omega = self._surface_weight(i)
+            if omega > 0.0:
+                self.grid.for_each_wide(i, self.state.pos[i], reach2, self._colour_fabric_pair,
+                                        acc)
+                if ti.static(self.model.plane_floor):   # (the floor's pairs not in M_i)
+                    acc.g[self.dim - 1] += self.floor.colour_at(self.state.pos[i][self.dim - 1])
+                iso = acc.m.trace() / self.dim
+                gl = acc.g.norm()
+                if (gl > 0.0 and iso > 0.0
+                        and acc.m.determinant() > FABRIC_DET_MIN * iso ** self.dim):
+                    inv = acc.m.inverse()
+                    n = acc.g / gl                  # T_i's normal
+                    along = inv.trace() - n.dot(inv @ n)      # tr of M^-1 in the tangent plane
+                    correction = ((self.dim - 1) / along) * inv
+            self.colour[i] = omega * self.coef.stress_K[None] * acc.g
+            self.fabric[i] = correction
+
+    @ti.func
     def _surface_weight(self, i):
         """omega_i = clamp((1 - n_i/n0) / (2 (1 - beta)), 0, 1) (C1): 1 on the free surface's
         outer layer (n ~ 0.5-0.75 n0), 1/2 at the free-surface threshold beta n0 (M3), 0 at
@@ -240,6 +343,9 @@ class StressTension:
             self.colour[s] = self.symmetry._mirrored(self.colour[self.symmetry.source[s]], s)
             if ti.static(self.delta > 0.0):
                 self.tolman[s] = self.tolman[self.symmetry.source[s]]
+            if ti.static(self.torque_pairs):     # R L R, R the reflection (diagonal)
+                sign = self.symmetry._mirrored(ti.Vector.one(float, self.dim), s)
+                self.fabric[s] = self.fabric[self.symmetry.source[s]] * sign.outer_product(sign)
 
     @ti.func
     def _pair_weight(self, r):
@@ -256,12 +362,26 @@ class StressTension:
         return f
 
     @ti.func
+    def _surface_pair_tension(self, i, j, gi, gj, rij):
+        """(s_i T_i L_i + s_j T_j L_j) r_ij (C3b), T_j = 0 for walls and dummies."""
+        f = stress_times(gi, self.fabric[i] @ rij) * self._tension(i)
+        if self.state.kind[j] == FLUID:
+            f += stress_times(gj, self.fabric[j] @ rij) * self._tension(j)
+        return f
+
+    @ti.func
     def _divergence_pair(self, i, j, rij, r2, acc: ti.template()):
         kind_j = self.state.kind[j]
         if kind_j != GONE:
             r = ti.sqrt(r2)
             gi, gj = self.colour[i], self.colour[j]
-            acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r)
+            if ti.static(self.surface_pairs):      # C3b: the pairs weighted
+                tension = self._pair_tension(i, j, gi, gj, rij)
+                if ti.static(self.torque_pairs):    # torque-free: T L
+                    tension = self._surface_pair_tension(i, j, gi, gj, rij)
+                acc.a += tension * (0.5 * (self._band(i) + self._band(j)) * self._pair_weight(r))
+            else:
+                acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r)
             if ti.static(self.delta > 0.0):
                 g_min = NORMAL_MIN / self.coef.l0[None]
                 if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
@@ -302,7 +422,7 @@ class StressTension:
         """Pass 2: a_i = (K_d / rho) sum_j (T_i + T_j) r_ij f_d(r_ij) (C3), T = sigma a (|g| I -
         g g^T/|g|) (C2), T_j = 0 for walls and dummies (the plane floor's layers: d_floor)."""
         scale = self.coef.stress_Kd[None] * self.coef.sigma[None] * self.coef.stress_a[None] / (
-            self.coef.rho[None])
+            self.coef.rho[None]) * self.pairs_scale
         reach2 = (self.pair_support * self.coef.l0[None]) ** 2    # H^2: the wide walk
         for at in range(self.state.n[None]):
             i = self.state.spread(at)
@@ -314,7 +434,13 @@ class StressTension:
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
                     ez[self.dim - 1] = self.floor.divergence_at(self.state.pos[i][self.dim - 1])
-                    acc.a += stress_times(self.colour[i], ez) * self._tension(i)
+                    floor_share = stress_times(self.colour[i], ez) * self._tension(i)
+                    if ti.static(self.surface_pairs):     # C3b: the layers weigh 0
+                        floor_share *= 0.5 * self._band(i)
+                        if ti.static(self.torque_pairs):
+                            floor_share = 0.5 * self._band(i) * stress_times(
+                                self.colour[i], self.fabric[i] @ ez) * self._tension(i)
+                    acc.a += floor_share
                 self.accel[i] = scale * acc.a
                 if ti.static(self.delta > 0.0):
                     s_next = tolman_factor(acc.h, self.delta * self.coef.l0[None])      # C5
