@@ -158,6 +158,7 @@ def test_info_gives_the_band_and_the_factor(capsys):
     assert st["constants"]["band_B"] == STRESS_SURFACE_BAND
     assert st["constants"]["a_factor"] == pytest.approx(stress_pairs_scale(2, 2.1, "surface"))
     assert "delta_l0" not in st["constants"]
+    assert st["what"].endswith("(C3b, torque-free)")         # 2D: each T_i through its L_i
     assert main(["info", "quick-2d", "--set", "numerics.surface_tension=stress",
                  "--set", "numerics.stress_pairs=surface", "--set", "scene.re_ratio=3.1"]) == 2
     err = capsys.readouterr().err

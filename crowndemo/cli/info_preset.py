@@ -34,7 +34,10 @@ def surface_tension_summary(model: str, lat, sigma: float, pairs: str = "all") -
         constants = {"a": lat.stress_a, "K_1_m2": lat.stress_K, "K_d_1_m2": lat.stress_Kd,
                      "H_l0": stress_pair_support(lat.dim, ratio), "F": factor}
         if pairs == "surface":    # C3b (method.md §4c)
-            what += ", C3's pairs weighted by the surface band (C3b)"
+            from ..core.params import stress_surface_pairs
+            what += ", C3's pairs weighted by the surface band (C3b" + (
+                ", torque-free)" if stress_surface_pairs(ratio)["torque_free"][lat.dim]
+                else ")")
             constants["band_B"] = STRESS_SURFACE_BAND
             constants["a_factor"] = stress_pairs_scale(lat.dim, ratio, pairs)
         if delta > 0:      # C5's curvature correction (3D; 2D at 3.1 l0)
