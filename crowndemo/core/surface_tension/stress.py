@@ -60,9 +60,9 @@ number density (S17), the free surface's pressure and, in 3D, a curvature correc
    walks to H where omega_i > 0; I where M_i is degenerate), so that T_i L_i M_i is symmetric
    (the idea of M2c and of Bonet & Lok's 1999 corrected gradient) and L_i's mean gain along
    the surface is 1: the pairs exert no torque and the free drops hold still. Not in 3D,
-   whose free drop held still without it: there L_i, following the fabric's strain in the
-   mode, fed it, and the drop's mode decayed at 0.65 of the viscous rate, 5 % slow (the
-   class attribute ``torque_free`` sets either for a study);
+   whose free drop held still without it: there with it the stress fed the mode, which
+   decayed at 0.65 of the viscous rate, 5 % slow (the class attribute ``torque_free`` sets
+   either for a study);
 3. the free surface's pressure (C4): a fluid particle that S17/M3 left at P = 0 and that has a
    colour gradient takes the normal stress its own tension carries,
    P_i = F rho l0 max(0, a_i . g_i/|g_i|),
