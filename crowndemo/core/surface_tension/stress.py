@@ -354,19 +354,20 @@ class StressTension:
         return stress_pair_kernel(r, self.pair_support * l0, l0)   # H (compile time)
 
     @ti.func
-    def _pair_tension(self, i, j, gi, gj, rij):
-        """(s_i T_i + s_j T_j) r_ij (C3, C5), T_j = 0 for walls and dummies."""
-        f = stress_times(gi, rij) * self._tension(i)
-        if self.state.kind[j] == FLUID:
-            f += stress_times(gj, rij) * self._tension(j)
-        return f
+    def _through(self, i, r):
+        """L_i r with C3b's torque-free pairs, r otherwise."""
+        out = r
+        if ti.static(self.torque_pairs):
+            out = self.fabric[i] @ r
+        return out
 
     @ti.func
-    def _surface_pair_tension(self, i, j, gi, gj, rij):
-        """(s_i T_i L_i + s_j T_j L_j) r_ij (C3b), T_j = 0 for walls and dummies."""
-        f = stress_times(gi, self.fabric[i] @ rij) * self._tension(i)
+    def _pair_tension(self, i, j, gi, gj, rij):
+        """(s_i T_i L_i + s_j T_j L_j) r_ij (C3, C5; L = I but with C3b's torque-free pairs),
+        T_j = 0 for walls and dummies."""
+        f = stress_times(gi, self._through(i, rij)) * self._tension(i)
         if self.state.kind[j] == FLUID:
-            f += stress_times(gj, self.fabric[j] @ rij) * self._tension(j)
+            f += stress_times(gj, self._through(j, rij)) * self._tension(j)
         return f
 
     @ti.func
@@ -375,13 +376,10 @@ class StressTension:
         if kind_j != GONE:
             r = ti.sqrt(r2)
             gi, gj = self.colour[i], self.colour[j]
+            f = self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r)
             if ti.static(self.surface_pairs):      # C3b: the pairs weighted
-                tension = self._pair_tension(i, j, gi, gj, rij)
-                if ti.static(self.torque_pairs):    # torque-free: T L
-                    tension = self._surface_pair_tension(i, j, gi, gj, rij)
-                acc.a += tension * (0.5 * (self._band(i) + self._band(j)) * self._pair_weight(r))
-            else:
-                acc.a += self._pair_tension(i, j, gi, gj, rij) * self._pair_weight(r)
+                f *= 0.5 * (self._band(i) + self._band(j))
+            acc.a += f
             if ti.static(self.delta > 0.0):
                 g_min = NORMAL_MIN / self.coef.l0[None]
                 if r < self.coef.re[None] and gj.norm() > g_min and gi.norm() > g_min:
@@ -434,12 +432,10 @@ class StressTension:
                 if ti.static(self.model.plane_floor):
                     ez = ti.Vector.zero(float, self.dim)
                     ez[self.dim - 1] = self.floor.divergence_at(self.state.pos[i][self.dim - 1])
-                    floor_share = stress_times(self.colour[i], ez) * self._tension(i)
+                    floor_share = stress_times(self.colour[i], self._through(i, ez)) * (
+                        self._tension(i))
                     if ti.static(self.surface_pairs):     # C3b: the layers weigh 0
                         floor_share *= 0.5 * self._band(i)
-                        if ti.static(self.torque_pairs):
-                            floor_share = 0.5 * self._band(i) * stress_times(
-                                self.colour[i], self.fabric[i] @ ez) * self._tension(i)
                     acc.a += floor_share
                 self.accel[i] = scale * acc.a
                 if ti.static(self.delta > 0.0):
